@@ -1,0 +1,12 @@
+//! incise-sim: the simulation core of incise.
+//!
+//! Tet meshes and their file formats, materials, the XPBD Neo-Hookean solver (CPU
+//! reference), Cauchy/von Mises stress and stress-based cutting. No windowing, no XR:
+//! the scalpel enters the solver as plain sphere data. Equations are cited from
+//! `PHYSICS.md` (the project's restatement of the three source papers).
+
+pub mod error;
+pub mod mesh;
+
+pub use error::MeshError;
+pub use mesh::{MeshBuildReport, RawMesh, TetMesh, TriSurface};

@@ -1,0 +1,2 @@
+//! incise command-line entry point.
+fn main() {}
