@@ -57,7 +57,9 @@ pub enum MeshError {
         node: u32,
     },
     /// A tet's volume is (nearly) zero: it cannot carry rest data.
-    #[error("tet {tet} is degenerate: volume {volume:e} m^3 is below the tolerance {tolerance:e} m^3")]
+    #[error(
+        "tet {tet} is degenerate: volume {volume:e} m^3 is below the tolerance {tolerance:e} m^3"
+    )]
     DegenerateTet {
         /// Tet index (0-based).
         tet: usize,

@@ -5,8 +5,19 @@
 //! the scalpel enters the solver as plain sphere data. Equations are cited from
 //! `PHYSICS.md` (the project's restatement of the three source papers).
 
+pub mod cutting;
 pub mod error;
+pub mod generate;
+pub mod grab;
+pub mod io;
+pub mod material;
 pub mod mesh;
+pub mod selection;
+pub mod skin;
+pub mod stress;
+pub mod xpbd;
 
 pub use error::MeshError;
+pub use material::Material;
 pub use mesh::{MeshBuildReport, RawMesh, TetMesh, TriSurface};
+pub use xpbd::{Solver, SolverParams};

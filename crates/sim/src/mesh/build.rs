@@ -28,6 +28,7 @@ impl TetMesh {
             positions,
             mut tets,
             warnings,
+            ..
         } = raw;
         if positions.len() < 4 || tets.is_empty() {
             return Err(MeshError::Empty {
@@ -169,6 +170,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
             tets: vec![[0, 1, 2, 3]],
             warnings: vec![],
+            boundary_faces: None,
         }
     }
 
@@ -196,7 +198,10 @@ mod tests {
         let mut raw = unit_tet();
         raw.tets[0][3] = 9;
         let err = TetMesh::from_raw(raw).unwrap_err();
-        assert!(matches!(err, MeshError::NodeIndexOutOfRange { node: 9, .. }));
+        assert!(matches!(
+            err,
+            MeshError::NodeIndexOutOfRange { node: 9, .. }
+        ));
     }
 
     #[test]
@@ -205,6 +210,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE],
             tets: vec![[0, 1, 2, 3], [1, 2, 3, 4]],
             warnings: vec![],
+            boundary_faces: None,
         };
         let (mesh, _) = TetMesh::from_raw(raw).unwrap();
         assert_eq!(mesh.boundary.len(), 6);

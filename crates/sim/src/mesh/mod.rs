@@ -2,6 +2,7 @@
 //! (PHYSICS.md §1.1), adjacency and boundary faces.
 
 mod build;
+pub mod quality;
 mod surface;
 pub mod topology;
 
@@ -26,6 +27,8 @@ pub struct RawMesh {
     pub tets: Vec<[u32; 4]>,
     /// Non-fatal remarks from the reader (e.g. skipped element types), one per line.
     pub warnings: Vec<String>,
+    /// Boundary triangles given by the file (TetGen `.face`), 0-based; `None` when absent.
+    pub boundary_faces: Option<Vec<[u32; 3]>>,
 }
 
 /// A validated tet mesh with its rest state.

@@ -1,0 +1,32 @@
+//! Per-frame statistics reported by the solver.
+
+use serde::Serialize;
+
+/// What one frame did, for report.json.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct FrameStats {
+    /// Frame index (0-based).
+    pub frame: u64,
+    /// Simulation time at the end of the frame, s.
+    pub sim_time: f64,
+    /// Substeps taken.
+    pub substeps: u32,
+    /// Largest von Mises stress over live tets, Pa.
+    pub max_von_mises: f32,
+    /// Mean von Mises stress over live tets, Pa.
+    pub mean_von_mises: f32,
+    /// Tets released in this frame.
+    pub released_now: usize,
+    /// Tets released so far.
+    pub released_total: usize,
+    /// Nodes retired so far.
+    pub retired_nodes: usize,
+    /// Current volume of the live tets over their rest volume.
+    pub volume_ratio: f64,
+    /// Kinetic energy ½ Σ m v², J.
+    pub kinetic_energy: f64,
+    /// Wall time of the substeps (prediction, projection, velocity update), ms.
+    pub solve_ms: f64,
+    /// Wall time of stress, guards and release, ms.
+    pub stress_ms: f64,
+}

@@ -1,0 +1,534 @@
+//! The XPBD small-steps solver (PHYSICS.md §1.2): prediction, pins and grabs, coloured
+//! Gauss-Seidel projection of the Neo-Hookean constraints, velocity update and damping;
+//! per frame: stress (§1.3), release (§1.4) and the NaN / inversion guards.
+
+use std::time::Instant;
+
+use glam::{Mat3, Quat, Vec3};
+use rayon::prelude::*;
+
+use super::coloring::greedy_tet_colors;
+use super::neo_hookean::{TetTerms, deformation_gradient, project_tet};
+use super::shared_nodes::SharedNodes;
+use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
+use super::{FrameStats, SolverError, SolverParams};
+use crate::cutting::{CutState, ReleaseEvent};
+use crate::grab::Grab;
+use crate::material::{Lame, Material};
+use crate::mesh::TetMesh;
+use crate::stress::tet_stress;
+
+/// Tets per rayon task: large enough to amortise scheduling, small enough to balance.
+const CHUNK: usize = 256;
+
+/// How a node moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NodeKind {
+    /// Integrated by the solver.
+    Free,
+    /// Fixed at its initial position.
+    Pinned,
+    /// Moved kinematically by grab number `n`.
+    Grabbed(u32),
+    /// No live tet left: frozen and hidden.
+    Retired,
+}
+
+/// Packed per-tet data in colour order: what one projection reads.
+#[derive(Debug, Clone, Copy)]
+struct TetSlot {
+    nodes: [u32; 4],
+    terms: TetTerms,
+    live: bool,
+}
+
+/// Solver state for one soft body.
+pub struct Solver {
+    mesh: TetMesh,
+    lame: Lame,
+    params: SolverParams,
+    x: Vec<Vec3>,
+    x_prev: Vec<Vec3>,
+    v: Vec<Vec3>,
+    mass: Vec<f32>,
+    inv_mass: Vec<f32>,
+    kind: Vec<NodeKind>,
+    start: Vec<Vec3>,
+    grabs: Vec<Grab>,
+    slots: Vec<TetSlot>,
+    color_ranges: Vec<std::ops::Range<usize>>,
+    slot_of_tet: Vec<u32>,
+    lambda_h: Vec<f32>,
+    rotation: Vec<Quat>,
+    von_mises: Vec<f32>,
+    det_f: Vec<f32>,
+    inverted_frames: Vec<u32>,
+    cut: CutState,
+    frame: u64,
+    time: f64,
+    pool: Option<rayon::ThreadPool>,
+}
+
+impl Solver {
+    /// A solver for `mesh` made of `material`, starting at rest.
+    pub fn new(
+        mesh: TetMesh,
+        material: Material,
+        params: SolverParams,
+    ) -> Result<Self, SolverError> {
+        material.validate()?;
+        params.validate()?;
+        let lame = material.lame();
+        let (colors, ncolors) = greedy_tet_colors(mesh.node_count(), &mesh.tets);
+        let mut order: Vec<u32> = (0..mesh.tet_count() as u32).collect();
+        order.sort_by_key(|&t| (colors[t as usize], t));
+        let mut color_ranges = Vec::with_capacity(ncolors);
+        let mut begin = 0;
+        for c in 0..ncolors as u32 {
+            let end = begin
+                + order[begin..]
+                    .iter()
+                    .take_while(|&&t| colors[t as usize] == c)
+                    .count();
+            color_ranges.push(begin..end);
+            begin = end;
+        }
+        let mut slot_of_tet = vec![0u32; mesh.tet_count()];
+        for (s, &t) in order.iter().enumerate() {
+            slot_of_tet[t as usize] = s as u32;
+        }
+        let mass = mesh.lumped_masses(material.density);
+        let inv_mass: Vec<f32> = mass
+            .iter()
+            .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
+            .collect();
+        let (kappa, tet) = stiffness_number(&mesh, &inv_mass, lame, params.substep());
+        if kappa > MAX_STIFFNESS_NUMBER {
+            return Err(SolverError::Unstable {
+                h_ms: params.substep() * 1e3,
+                tet,
+                kappa,
+                max: MAX_STIFFNESS_NUMBER,
+                needed: substeps_needed(kappa, params.substeps),
+            });
+        }
+        let pool = match params.threads {
+            1 => None,
+            n => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .map_err(|e| SolverError::ThreadPool {
+                        threads: n,
+                        msg: e.to_string(),
+                    })?,
+            ),
+        };
+        let n = mesh.node_count();
+        let t = mesh.tet_count();
+        let mut solver = Solver {
+            x: mesh.rest_positions.clone(),
+            x_prev: mesh.rest_positions.clone(),
+            start: mesh.rest_positions.clone(),
+            v: vec![Vec3::ZERO; n],
+            mass,
+            inv_mass,
+            kind: vec![NodeKind::Free; n],
+            grabs: Vec::new(),
+            slots: Vec::new(),
+            color_ranges,
+            slot_of_tet,
+            lambda_h: vec![0.0; t],
+            rotation: vec![Quat::IDENTITY; t],
+            von_mises: vec![0.0; t],
+            det_f: vec![1.0; t],
+            inverted_frames: vec![0; t],
+            cut: CutState::new(&mesh),
+            frame: 0,
+            time: 0.0,
+            pool,
+            lame,
+            params,
+            mesh,
+        };
+        solver.slots = order
+            .iter()
+            .map(|&t| TetSlot {
+                nodes: solver.mesh.tets[t as usize],
+                terms: solver.terms(t as usize),
+                live: true,
+            })
+            .collect();
+        Ok(solver)
+    }
+
+    /// Compliance terms of tet `t` for the current substep length.
+    fn terms(&self, t: usize) -> TetTerms {
+        let h = self.params.substep();
+        let v = self.mesh.rest_volume[t];
+        TetTerms {
+            dm_inv: self.mesh.dm_inv[t],
+            // PHYSICS.md §1.2: α_H = 1/(λV), α_D = 1/(μV), α̃ = α/h².
+            alpha_h: 1.0 / (self.lame.lambda * v * h * h),
+            alpha_d: 1.0 / (self.lame.mu * v * h * h),
+            gamma: 1.0 + self.lame.mu / self.lame.lambda,
+        }
+    }
+
+    /// The mesh being simulated (rest state and topology).
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+
+    /// Settings in use.
+    pub fn params(&self) -> &SolverParams {
+        &self.params
+    }
+
+    /// Lamé parameters in use.
+    pub fn lame(&self) -> Lame {
+        self.lame
+    }
+
+    /// Current node positions, m.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.x
+    }
+
+    /// Replace all node positions (e.g. to start from a deformed state); velocities are zeroed.
+    pub fn set_positions(&mut self, x: &[Vec3]) {
+        self.x.copy_from_slice(x);
+        self.x_prev.copy_from_slice(x);
+        self.start.copy_from_slice(x);
+        self.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
+    }
+
+    /// Current node velocities, m/s.
+    pub fn velocities(&self) -> &[Vec3] {
+        &self.v
+    }
+
+    /// Lumped node masses, kg.
+    pub fn masses(&self) -> &[f32] {
+        &self.mass
+    }
+
+    /// How each node moves.
+    pub fn node_kinds(&self) -> &[NodeKind] {
+        &self.kind
+    }
+
+    /// von Mises stress per tet (mesh order) as of the last frame, Pa.
+    pub fn von_mises(&self) -> &[f32] {
+        &self.von_mises
+    }
+
+    /// det F per tet (mesh order) as of the last frame.
+    pub fn det_f(&self) -> &[f32] {
+        &self.det_f
+    }
+
+    /// Cut state: live tets, visible faces, retired nodes.
+    pub fn cut(&self) -> &CutState {
+        &self.cut
+    }
+
+    /// Number of tet colours (parallel passes per substep).
+    pub fn color_count(&self) -> usize {
+        self.color_ranges.len()
+    }
+
+    /// Frames stepped so far.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Simulation time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Fix `nodes` at their current positions.
+    pub fn pin(&mut self, nodes: &[u32]) {
+        for &i in nodes {
+            self.kind[i as usize] = NodeKind::Pinned;
+            self.inv_mass[i as usize] = 0.0;
+            self.v[i as usize] = Vec3::ZERO;
+        }
+    }
+
+    /// Add a scripted grab; its nodes become kinematic and follow its path from their
+    /// current positions.
+    pub fn add_grab(&mut self, grab: Grab) {
+        let id = self.grabs.len() as u32;
+        for &i in &grab.nodes {
+            self.kind[i as usize] = NodeKind::Grabbed(id);
+            self.inv_mass[i as usize] = 0.0;
+            self.start[i as usize] = self.x[i as usize];
+        }
+        self.grabs.push(grab);
+    }
+
+    /// Release tets by hand (mesh indices); returns what changed.
+    pub fn release(&mut self, tets: &[u32]) -> ReleaseEvent {
+        let ev = self.cut.release(&self.mesh, tets);
+        for &t in &ev.tets {
+            self.slots[self.slot_of_tet[t as usize] as usize].live = false;
+        }
+        for &n in &ev.retired_nodes {
+            self.kind[n as usize] = NodeKind::Retired;
+            self.inv_mass[n as usize] = 0.0;
+            self.v[n as usize] = Vec3::ZERO;
+        }
+        ev
+    }
+
+    /// Advance one frame: `substeps` XPBD substeps, then stress, guards and release.
+    ///
+    /// On a NaN/Inf position or a tet inverted for longer than `max_inverted_frames`, the
+    /// frame is rolled back and an error names the frame and the tet.
+    pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
+        let saved = (self.x.clone(), self.v.clone());
+        let t0 = Instant::now();
+        match self.pool.take() {
+            Some(pool) => {
+                pool.install(|| self.run_substeps(true));
+                self.pool = Some(pool);
+            }
+            None => self.run_substeps(false),
+        }
+        self.time += self.params.frame_dt as f64;
+        let t1 = Instant::now();
+        let checked = match self.pool.take() {
+            Some(pool) => {
+                let r = pool.install(|| self.update_stress_and_check(true));
+                self.pool = Some(pool);
+                r
+            }
+            None => self.update_stress_and_check(false),
+        };
+        if let Err(e) = checked {
+            self.x = saved.0;
+            self.x_prev.clone_from(&self.x);
+            self.v = saved.1;
+            self.time -= self.params.frame_dt as f64;
+            return Err(e);
+        }
+        let released = self.release_overstressed();
+        let mut stats = self.stats(released);
+        stats.solve_ms = (t1 - t0).as_secs_f64() * 1e3;
+        stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
+        self.frame += 1;
+        Ok(stats)
+    }
+
+    fn run_substeps(&mut self, parallel: bool) {
+        let h = self.params.substep();
+        for s in 0..self.params.substeps {
+            let t = self.time + (s + 1) as f64 * h as f64;
+            self.predict(h, t);
+            for c in 0..self.color_ranges.len() {
+                self.project_color(c, parallel);
+            }
+            self.update_velocities(h);
+        }
+    }
+
+    /// `v += h g; x_prev = x; x += h v` for free nodes; kinematic nodes jump to their
+    /// target at the end of the substep.
+    // PHYSICS.md §1.2, small-steps loop, prediction.
+    fn predict(&mut self, h: f32, t: f64) {
+        let offsets: Vec<Vec3> = self.grabs.iter().map(|g| g.offset_at(t)).collect();
+        let g = self.params.gravity;
+        for i in 0..self.x.len() {
+            self.x_prev[i] = self.x[i];
+            match self.kind[i] {
+                NodeKind::Free => {
+                    self.v[i] += h * g;
+                    self.x[i] += h * self.v[i];
+                }
+                NodeKind::Grabbed(k) => self.x[i] = self.start[i] + offsets[k as usize],
+                NodeKind::Pinned | NodeKind::Retired => {}
+            }
+        }
+    }
+
+    /// Project every live tet of colour `c` (no two share a node).
+    fn project_color(&mut self, c: usize, parallel: bool) {
+        let range = self.color_ranges[c].clone();
+        let mode = self.params.projection;
+        let nodes = SharedNodes::new(&mut self.x);
+        let inv_mass = &self.inv_mass;
+        let work = |slot: &TetSlot, lambda: &mut f32| {
+            if !slot.live {
+                return;
+            }
+            let idx = slot.nodes;
+            // SAFETY: tets of one colour share no node, so this tet's nodes are touched by
+            // this task only during the pass.
+            let mut p = idx.map(|i| unsafe { nodes.get(i) });
+            let w = idx.map(|i| inv_mass[i as usize]);
+            *lambda = project_tet(&mut p, &w, &slot.terms, mode);
+            for k in 0..4 {
+                // SAFETY: as above.
+                unsafe { nodes.set(idx[k], p[k]) };
+            }
+        };
+        let slots = &self.slots[range.clone()];
+        let lambdas = &mut self.lambda_h[range];
+        if parallel && slots.len() > CHUNK {
+            slots
+                .par_iter()
+                .zip(lambdas.par_iter_mut())
+                .with_min_len(CHUNK)
+                .for_each(|(s, l)| work(s, l));
+        } else {
+            slots
+                .iter()
+                .zip(lambdas.iter_mut())
+                .for_each(|(s, l)| work(s, l));
+        }
+    }
+
+    /// `v = (x − x_prev)/h`, then damping.
+    // PHYSICS.md §1.2, small-steps loop, velocity update.
+    fn update_velocities(&mut self, h: f32) {
+        let keep = (1.0 - self.params.damping * h).max(0.0);
+        let inv_h = 1.0 / h;
+        for i in 0..self.x.len() {
+            self.v[i] = match self.kind[i] {
+                NodeKind::Free => (self.x[i] - self.x_prev[i]) * inv_h * keep,
+                NodeKind::Grabbed(_) => (self.x[i] - self.x_prev[i]) * inv_h,
+                NodeKind::Pinned | NodeKind::Retired => Vec3::ZERO,
+            };
+        }
+    }
+
+    /// Stress and det F per live tet; NaN and inversion guards.
+    fn update_stress_and_check(&mut self, parallel: bool) -> Result<(), SolverError> {
+        if let Some(node) = self.x.iter().position(|p| !p.is_finite()) {
+            let tet = self.mesh.tets_of_node(node).first().copied().unwrap_or(0) as usize;
+            return Err(SolverError::NonFinite {
+                frame: self.frame,
+                node,
+                tet,
+            });
+        }
+        let h = self.params.substep();
+        let mu = self.lame.mu;
+        let (mesh, x, cut) = (&self.mesh, &self.x, &self.cut);
+        let (lambda_h, slot_of_tet) = (&self.lambda_h, &self.slot_of_tet);
+        let compute = |t: usize, out: (&mut f32, &mut f32, &mut Quat)| {
+            if !cut.is_live(t) {
+                *out.0 = 0.0;
+                return;
+            }
+            let idx = mesh.tets[t];
+            let p = idx.map(|i| x[i as usize]);
+            let f: Mat3 = deformation_gradient(&p, &mesh.dm_inv[t]);
+            let lam = lambda_h[slot_of_tet[t] as usize];
+            let s = tet_stress(&f, mu, lam, h * h, mesh.rest_volume[t], *out.2);
+            *out.0 = s.von_mises;
+            *out.1 = f.determinant();
+            *out.2 = s.rotation;
+        };
+        if parallel {
+            self.von_mises
+                .par_iter_mut()
+                .zip(self.det_f.par_iter_mut())
+                .zip(self.rotation.par_iter_mut())
+                .enumerate()
+                .with_min_len(CHUNK)
+                .for_each(|(t, ((vm, d), r))| compute(t, (vm, d, r)));
+        } else {
+            for t in 0..self.von_mises.len() {
+                compute(
+                    t,
+                    (
+                        &mut self.von_mises[t],
+                        &mut self.det_f[t],
+                        &mut self.rotation[t],
+                    ),
+                );
+            }
+        }
+        let limit = self.params.max_inverted_frames;
+        let mut worst: Option<(usize, u32)> = None;
+        for t in 0..self.det_f.len() {
+            if self.cut.is_live(t) && self.det_f[t] <= 0.0 {
+                self.inverted_frames[t] += 1;
+                if self.inverted_frames[t] > limit && worst.is_none() {
+                    worst = Some((t, self.inverted_frames[t]));
+                }
+            } else {
+                self.inverted_frames[t] = 0;
+            }
+        }
+        if let Some((tet, frames)) = worst {
+            return Err(SolverError::Inverted {
+                frame: self.frame,
+                tet,
+                frames,
+                det: self.det_f[tet],
+            });
+        }
+        Ok(())
+    }
+
+    /// Release live tets whose von Mises stress exceeds the threshold (PHYSICS.md §1.4, eq. 5).
+    fn release_overstressed(&mut self) -> usize {
+        let Some(threshold) = self.params.release_threshold else {
+            return 0;
+        };
+        let over: Vec<u32> = (0..self.von_mises.len())
+            .filter(|&t| self.cut.is_live(t) && self.von_mises[t] > threshold)
+            .map(|t| t as u32)
+            .collect();
+        if over.is_empty() {
+            return 0;
+        }
+        self.release(&over).tets.len()
+    }
+
+    fn stats(&self, released_now: usize) -> FrameStats {
+        let mut max_vm = 0.0f32;
+        let mut sum_vm = 0.0f64;
+        let mut live = 0usize;
+        let mut vol = 0.0f64;
+        let mut rest = 0.0f64;
+        for t in 0..self.von_mises.len() {
+            if self.cut.is_live(t) {
+                live += 1;
+                max_vm = max_vm.max(self.von_mises[t]);
+                sum_vm += self.von_mises[t] as f64;
+                let v0 = self.mesh.rest_volume[t] as f64;
+                rest += v0;
+                vol += v0 * self.det_f[t] as f64;
+            }
+        }
+        let ke = self
+            .v
+            .iter()
+            .zip(&self.mass)
+            .map(|(v, &m)| 0.5 * m as f64 * v.length_squared() as f64)
+            .sum();
+        FrameStats {
+            frame: self.frame,
+            sim_time: self.time,
+            substeps: self.params.substeps,
+            max_von_mises: max_vm,
+            mean_von_mises: if live > 0 {
+                (sum_vm / live as f64) as f32
+            } else {
+                0.0
+            },
+            released_now,
+            released_total: self.cut.released_count(),
+            retired_nodes: self.cut.retired_count(),
+            volume_ratio: if rest > 0.0 { vol / rest } else { 0.0 },
+            kinetic_energy: ke,
+            solve_ms: 0.0,
+            stress_ms: 0.0,
+        }
+    }
+}

@@ -1,0 +1,103 @@
+//! Command-line interface definition (clap).
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+/// incise: mixed-reality surgical cutting trainer (headless runner, mesh tools, benchmarks).
+#[derive(Debug, Parser)]
+#[command(name = "incise", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run a scene headless: report.json, .vtu snapshots and a .pvd collection.
+    Run {
+        /// Scene file (RON), e.g. config/intestine_pull.ron.
+        scene: PathBuf,
+        /// Frames to simulate (default: the scene's duration at its frame rate).
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Write a .vtu snapshot every K frames (0: none).
+        #[arg(long, default_value_t = 10)]
+        vtu_every: u64,
+        /// Solver threads (0: all cores; default: the scene's setting).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Mesh tools.
+    Mesh {
+        /// Which tool.
+        #[command(subcommand)]
+        command: MeshCommand,
+    },
+    /// Time the solver on the plate and the 34k-tet intestine, serial and all threads.
+    Bench {
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Frames to time per case (after 5 warm-up frames).
+        #[arg(long, default_value_t = 40)]
+        frames: u32,
+        /// Which cases to run.
+        #[arg(long, value_enum, default_value_t = BenchCase::All)]
+        case: BenchCase,
+    },
+}
+
+/// Mesh subcommands.
+#[derive(Debug, Subcommand)]
+pub enum MeshCommand {
+    /// Load a mesh and print counts and quality; exits 1 on a bad file.
+    Check {
+        /// .node/.ele, .msh, .vtk or .vtu file.
+        file: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Generate a procedural mesh as TetGen .node/.ele plus an .obj skin.
+    Gen {
+        /// Which mesh.
+        #[arg(value_enum)]
+        kind: GenKind,
+        /// Output base path (writes BASE.node, BASE.ele, BASE.obj).
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// Procedural meshes available from the CLI.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum GenKind {
+    /// Nakao 2003 plate, 16 × 16 × 0.4 cm.
+    Plate,
+    /// ≈34k-tet curved intestine with a finer skin.
+    Intestine,
+    /// 10 × 2 × 2 cm block, 10 × 2 × 2 cells.
+    Block,
+    /// 20 cm × 2 cm × 2 cm beam, 40 × 4 × 4 cells.
+    Beam,
+}
+
+/// Benchmark case selection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BenchCase {
+    /// Plate and intestine.
+    All,
+    /// The Nakao plate.
+    Plate,
+    /// The 34k-tet intestine.
+    Intestine,
+}

@@ -1,0 +1,10 @@
+//! The incise application: scenes, the headless runner, reports, benchmarks and mesh tools.
+//! The binary in `main.rs` is a thin CLI over these modules; `tests/` drives both.
+
+pub mod bench;
+pub mod cli;
+pub mod mesh_cmd;
+pub mod progress;
+pub mod report;
+pub mod run;
+pub mod scene;

@@ -1,0 +1,141 @@
+//! Turning a scene into a ready solver: mesh, skin, material, pins, grabs.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow};
+use incise_sim::grab::Grab;
+use incise_sim::skin::Skin;
+use incise_sim::{Material, MeshBuildReport, RawMesh, Solver, TetMesh, TriSurface, generate, io};
+
+use super::{Generator, MaterialChoice, MeshSource, Scene, SkinSource, load_materials};
+
+/// A scene with its mesh built and its solver set up.
+pub struct BuiltScene {
+    /// The solver, at rest, with pins and grabs applied.
+    pub solver: Solver,
+    /// The skin embedded in the tets.
+    pub skin: Skin,
+    /// The material in use (resolved preset).
+    pub material: Material,
+    /// Name of the material preset, or "custom".
+    pub material_name: String,
+    /// What building the mesh changed (re-oriented tets, reader warnings).
+    pub mesh_report: MeshBuildReport,
+    /// Pinned node count.
+    pub pinned_nodes: usize,
+    /// Grabbed node count.
+    pub grabbed_nodes: usize,
+}
+
+/// Build `scene` (read from `scene_path`, whose folder anchors relative paths); presets
+/// come from `materials.ron` beside the scene file.
+pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> Result<BuiltScene> {
+    let dir = scene_path.parent().unwrap_or(Path::new("."));
+    let (raw, generated_skin) = raw_mesh(&scene.mesh, dir)?;
+    let (mesh, mesh_report) =
+        TetMesh::from_raw(raw).with_context(|| format!("{}: mesh", scene_path.display()))?;
+    let skin = match (&scene.skin, generated_skin) {
+        (SkinSource::Auto, Some(surface)) => Skin::embed(&mesh, surface),
+        (SkinSource::Auto | SkinSource::Boundary, _) => Skin::from_boundary(&mesh),
+        (SkinSource::Obj { path, units }, _) => {
+            let p = dir.join(path);
+            let mut s = io::load_surface(&p)
+                .with_context(|| format!("skin of {}", scene_path.display()))?;
+            scale(&mut s.positions, units.scale());
+            Skin::embed(&mesh, s)
+        }
+    };
+    let (material, material_name) = match &scene.material {
+        MaterialChoice::Custom(m) => (*m, "custom".to_string()),
+        MaterialChoice::Preset(name) => {
+            let file = dir.join("materials.ron");
+            let presets = load_materials(&file)?;
+            let m = presets.get(name).ok_or_else(|| {
+                anyhow!(
+                    "{}: material preset \"{name}\" is not in {} (known: {})",
+                    scene_path.display(),
+                    file.display(),
+                    presets.keys().cloned().collect::<Vec<_>>().join(", ")
+                )
+            })?;
+            (*m, name.clone())
+        }
+    };
+    let mut params = scene.solver.clone();
+    params.release_threshold = scene.cutting.as_ref().map(|c| c.von_mises_threshold);
+    if let Some(t) = threads {
+        params.threads = t;
+    }
+    let rest = mesh.rest_positions.clone();
+    let mut solver =
+        Solver::new(mesh, material, params).with_context(|| scene_path.display().to_string())?;
+    let mut pinned = 0;
+    for (i, sel) in scene.pins.iter().enumerate() {
+        let nodes = sel
+            .select(&rest)
+            .with_context(|| format!("{}: pins[{i}]", scene_path.display()))?;
+        pinned += nodes.len();
+        solver.pin(&nodes);
+    }
+    let mut grabbed = 0;
+    for (i, g) in scene.grabs.iter().enumerate() {
+        let nodes = g
+            .nodes
+            .select(&rest)
+            .with_context(|| format!("{}: grabs[{i}].nodes", scene_path.display()))?;
+        grabbed += nodes.len();
+        solver.add_grab(Grab {
+            nodes,
+            waypoints: g.path.clone(),
+            speed: g.speed,
+            start_time: g.start,
+        });
+    }
+    Ok(BuiltScene {
+        solver,
+        skin,
+        material,
+        material_name,
+        mesh_report,
+        pinned_nodes: pinned,
+        grabbed_nodes: grabbed,
+    })
+}
+
+/// The raw tet mesh (in metres) and the generator's skin, if any.
+pub fn raw_mesh(source: &MeshSource, dir: &Path) -> Result<(RawMesh, Option<TriSurface>)> {
+    Ok(match source {
+        MeshSource::File { path, units } => {
+            let mut raw = io::load_mesh(&dir.join(path))?;
+            scale(&mut raw.positions, units.scale());
+            (raw, None)
+        }
+        MeshSource::Generate(g) => match g {
+            Generator::Plate => (generate::plate(), None),
+            Generator::Intestine(p) => {
+                let problems = p.problems();
+                if !problems.is_empty() {
+                    return Err(anyhow!(
+                        "mesh: Generate(Intestine(..)): {}",
+                        problems.join("; ")
+                    ));
+                }
+                let (raw, skin) = generate::intestine(p);
+                (raw, Some(skin))
+            }
+            Generator::Block { min, size, cells } => (generate::block(*min, *size, *cells), None),
+            Generator::Beam {
+                length,
+                width,
+                height,
+                cells,
+            } => (generate::beam(*length, *width, *height, *cells), None),
+        },
+    })
+}
+
+fn scale(points: &mut [glam::Vec3], s: f32) {
+    if s != 1.0 {
+        points.iter_mut().for_each(|p| *p *= s);
+    }
+}
