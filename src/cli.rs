@@ -47,8 +47,8 @@ pub enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Frames to time per case (after 5 warm-up frames).
-        #[arg(long, default_value_t = 40)]
+        /// Frames to time per case (after 2 warm-up frames).
+        #[arg(long, default_value_t = 10)]
         frames: u32,
         /// Which cases to run.
         #[arg(long, value_enum, default_value_t = BenchCase::All)]

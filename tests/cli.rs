@@ -1,0 +1,250 @@
+//! End-to-end tests of the `incise` binary: runs, reports, snapshots, errors, mesh tools,
+//! benchmark JSON, and the shipped scenes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn incise(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_incise"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("incise binary runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("incise-e2e-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn text(o: &[u8]) -> String {
+    String::from_utf8_lossy(o).into_owned()
+}
+
+/// A small tearing bar: pinned at x = 0, pulled along +x.
+const BAR: &str = r#"(
+    name: "bar",
+    mesh: Generate(Block(min: (0, -0.01, -0.01), size: (0.08, 0.02, 0.02), cells: (16, 4, 4))),
+    material: Custom((youngs_modulus: 20e3, poisson_ratio: 0.4, density: 1000)),
+    pins: [PlaneSide(point: (0.001, 0, 0), normal: (-1, 0, 0))],
+    grabs: [(nodes: PlaneSide(point: (0.079, 0, 0), normal: (1, 0, 0)), path: [(0.06, 0, 0)], speed: 0.1)],
+    solver: (substeps: 30, gravity: (0, 0, 0)),
+    cutting: Some((von_mises_threshold: 6e3)),
+    duration: 0.5,
+)"#;
+
+#[test]
+fn run_writes_report_snapshots_and_collection() {
+    let dir = temp_dir("run");
+    let scene = dir.join("bar.ron");
+    std::fs::write(&scene, BAR).unwrap();
+    let out = dir.join("out");
+    let o = incise(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--vtu-every",
+        "10",
+        "--threads",
+        "2",
+    ]);
+    assert!(o.status.success(), "stderr: {}", text(&o.stderr));
+    assert!(text(&o.stdout).contains("report:"));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["status"], "completed");
+    let frames = report["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 30, "0.5 s at 60 Hz");
+    for key in [
+        "sim_time",
+        "wall_ms",
+        "substeps",
+        "max_von_mises",
+        "mean_von_mises",
+        "released_total",
+        "volume_ratio",
+        "kinetic_energy",
+    ] {
+        assert!(frames[0].get(key).is_some(), "frame record lacks {key}");
+    }
+    let released = frames.last().unwrap()["released_total"].as_u64().unwrap();
+    assert!(released > 0, "the bar should tear");
+    // Releasing is irreversible: the count never decreases.
+    let counts: Vec<u64> = frames
+        .iter()
+        .map(|f| f["released_total"].as_u64().unwrap())
+        .collect();
+    assert!(counts.windows(2).all(|w| w[1] >= w[0]));
+    // Snapshots at frames 0, 10, 20, 30 and a collection naming them.
+    let pvd = std::fs::read_to_string(out.join("run.pvd")).unwrap();
+    for f in [
+        "snap_00000.vtu",
+        "snap_00010.vtu",
+        "snap_00020.vtu",
+        "snap_00030.vtu",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+        assert!(pvd.contains(f), "{f} not in run.pvd");
+    }
+    let last = std::fs::read_to_string(out.join("snap_00030.vtu")).unwrap();
+    for field in ["von_mises", "released", "velocity"] {
+        assert!(
+            last.contains(&format!("Name=\"{field}\"")),
+            "snapshot lacks {field}"
+        );
+    }
+}
+
+#[test]
+fn malformed_scene_names_file_line_and_field() {
+    let dir = temp_dir("bad-scene");
+    let scene = dir.join("bad.ron");
+    std::fs::write(
+        &scene,
+        BAR.replace("duration: 0.5,", "duration: 0.5,\n    durashun: 1,"),
+    )
+    .unwrap();
+    let o = incise(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(err.contains("bad.ron:10:"), "{err}");
+    assert!(err.contains("durashun"), "{err}");
+}
+
+#[test]
+fn unstable_settings_are_refused_with_advice() {
+    let dir = temp_dir("unstable");
+    let scene = dir.join("stiff.ron");
+    std::fs::write(&scene, BAR.replace("substeps: 30", "substeps: 2")).unwrap();
+    let o = incise(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("stiffness number") && err.contains("use at least"),
+        "{err}"
+    );
+}
+
+#[test]
+fn mesh_gen_then_check_round_trips() {
+    let dir = temp_dir("gen");
+    let base = dir.join("plate");
+    let o = incise(&["mesh", "gen", "plate", "--out", base.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(dir.join("plate.obj").exists());
+    let o = incise(&[
+        "mesh",
+        "check",
+        dir.join("plate.node").to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let q: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(q["nodes"], 1250);
+    assert_eq!(q["tets"], 3456);
+    assert_eq!(q["components"], 1);
+    assert_eq!(q["degenerate_tets"], 0);
+}
+
+#[test]
+fn broken_mesh_file_exits_1_naming_file_and_line() {
+    let dir = temp_dir("broken");
+    let f = dir.join("broken.vtk");
+    std::fs::write(
+        &f,
+        "# vtk DataFile Version 3.0\nbroken\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 float\n0 0 0\n1 0 0\n0 1 zero\n0 0 1\n",
+    )
+    .unwrap();
+    let o = incise(&["mesh", "check", f.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = text(&o.stderr);
+    assert!(err.contains("broken.vtk:8"), "{err}");
+}
+
+#[test]
+fn degenerate_mesh_is_reported_and_rejected() {
+    let dir = temp_dir("degenerate");
+    let node = dir.join("flat.node");
+    std::fs::write(
+        &node,
+        "5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n4 1 1 0\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("flat.ele"), "2 4 0\n0 0 1 2 3\n1 0 1 2 4\n").unwrap();
+    let o = incise(&["mesh", "check", node.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1));
+    let (out, err) = (text(&o.stdout), text(&o.stderr));
+    assert!(out.contains("degenerate tets  1"), "{out}");
+    assert!(err.contains("tet 1"), "{err}");
+}
+
+#[test]
+fn bench_json_has_the_documented_fields() {
+    let o = incise(&["bench", "--json", "--case", "plate", "--frames", "1"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let b: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let r = &b["results"][0];
+    for key in [
+        "case",
+        "tets",
+        "threads",
+        "device",
+        "ms_per_substep_median",
+        "ms_per_substep_min",
+        "peak_mib",
+    ] {
+        assert!(r.get(key).is_some(), "bench result lacks {key}");
+    }
+    assert_eq!(r["case"], "plate");
+    assert!(r["ms_per_substep_median"].as_f64().unwrap() > 0.0);
+}
+
+/// Every shipped scene parses, resolves its material and builds a stable solver.
+#[test]
+fn shipped_scenes_build() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["intestine_pull", "plate_stretch", "beam_sag"] {
+        let path = root.join("config").join(format!("{name}.ron"));
+        let scene = incise::scene::load_scene(&path).unwrap();
+        let built = incise::scene::build_scene(&scene, &path, Some(1))
+            .unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        assert!(built.pinned_nodes > 0, "{name} pins nothing");
+    }
+}
+
+/// The default scene tears: run its first 90 frames (1.5 s) and expect released tets and
+/// a wall that comes apart into more than one piece.
+#[test]
+fn intestine_pull_tears() {
+    let dir = temp_dir("intestine");
+    let o = incise(&[
+        "run",
+        "config/intestine_pull.ron",
+        "--frames",
+        "90",
+        "--vtu-every",
+        "0",
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let last = report["frames"].as_array().unwrap().last().unwrap().clone();
+    assert!(last["released_total"].as_u64().unwrap() > 100, "{last}");
+    assert_eq!(report["mesh"]["tets"], 34176);
+}
