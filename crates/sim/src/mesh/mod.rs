@@ -2,11 +2,13 @@
 //! (PHYSICS.md §1.1), adjacency and boundary faces.
 
 mod build;
+mod edges;
 pub mod quality;
 mod surface;
 pub mod topology;
 
 pub use build::{DEGENERATE_REL, MeshBuildReport};
+pub use edges::EdgeList;
 pub use surface::TriSurface;
 
 use glam::{Mat3, Vec3};
