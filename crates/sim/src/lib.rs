@@ -8,6 +8,8 @@
 pub mod cutting;
 pub mod error;
 pub mod generate;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod grab;
 pub mod io;
 pub mod material;

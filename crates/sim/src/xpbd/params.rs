@@ -138,6 +138,9 @@ pub enum SolverError {
         /// Substeps per frame that would satisfy the bound.
         needed: u32,
     },
+    /// The GPU device failed while stepping (device lost, readback failed).
+    #[error("GPU: {0}")]
+    Device(String),
     /// The thread pool could not be created.
     #[error("could not start {threads} solver threads: {msg}")]
     ThreadPool {

@@ -36,37 +36,38 @@ pub enum NodeKind {
 
 /// Packed per-tet data in colour order: what one projection reads.
 #[derive(Debug, Clone, Copy)]
-struct TetSlot {
-    nodes: [u32; 4],
-    terms: TetTerms,
-    live: bool,
+pub(crate) struct TetSlot {
+    pub(crate) nodes: [u32; 4],
+    pub(crate) terms: TetTerms,
+    pub(crate) live: bool,
 }
 
 /// Solver state for one soft body.
 pub struct Solver {
-    mesh: TetMesh,
-    lame: Lame,
-    params: SolverParams,
-    x: Vec<Vec3>,
-    x_prev: Vec<Vec3>,
-    v: Vec<Vec3>,
-    mass: Vec<f32>,
-    inv_mass: Vec<f32>,
-    kind: Vec<NodeKind>,
-    start: Vec<Vec3>,
-    grabs: Vec<Grab>,
-    slots: Vec<TetSlot>,
-    color_ranges: Vec<std::ops::Range<usize>>,
-    slot_of_tet: Vec<u32>,
-    lambda_h: Vec<f32>,
-    rotation: Vec<Quat>,
-    von_mises: Vec<f32>,
-    det_f: Vec<f32>,
-    inverted_frames: Vec<u32>,
-    cut: CutState,
-    frame: u64,
-    time: f64,
-    pool: Option<rayon::ThreadPool>,
+    pub(crate) mesh: TetMesh,
+    pub(crate) lame: Lame,
+    pub(crate) params: SolverParams,
+    pub(crate) x: Vec<Vec3>,
+    pub(crate) x_prev: Vec<Vec3>,
+    pub(crate) v: Vec<Vec3>,
+    pub(crate) mass: Vec<f32>,
+    pub(crate) inv_mass: Vec<f32>,
+    pub(crate) kind: Vec<NodeKind>,
+    pub(crate) start: Vec<Vec3>,
+    pub(crate) grabs: Vec<Grab>,
+    pub(crate) slots: Vec<TetSlot>,
+    pub(crate) color_ranges: Vec<std::ops::Range<usize>>,
+    pub(crate) slot_of_tet: Vec<u32>,
+    pub(crate) tet_of_slot: Vec<u32>,
+    pub(crate) lambda_h: Vec<f32>,
+    pub(crate) rotation: Vec<Quat>,
+    pub(crate) von_mises: Vec<f32>,
+    pub(crate) det_f: Vec<f32>,
+    pub(crate) inverted_frames: Vec<u32>,
+    pub(crate) cut: CutState,
+    pub(crate) frame: u64,
+    pub(crate) time: f64,
+    pub(crate) pool: Option<rayon::ThreadPool>,
 }
 
 impl Solver {
@@ -138,6 +139,7 @@ impl Solver {
             slots: Vec::new(),
             color_ranges,
             slot_of_tet,
+            tet_of_slot: order.clone(),
             lambda_h: vec![0.0; t],
             rotation: vec![Quat::IDENTITY; t],
             von_mises: vec![0.0; t],
@@ -404,8 +406,15 @@ impl Solver {
         }
     }
 
-    /// Stress and det F per live tet; NaN and inversion guards.
+    /// Stress and det F per live tet, then the NaN and inversion guards.
     fn update_stress_and_check(&mut self, parallel: bool) -> Result<(), SolverError> {
+        self.check_finite()?;
+        self.compute_stress(parallel);
+        self.check_inversion()
+    }
+
+    /// NaN/Inf guard on node positions.
+    pub(crate) fn check_finite(&self) -> Result<(), SolverError> {
         if let Some(node) = self.x.iter().position(|p| !p.is_finite()) {
             let tet = self.mesh.tets_of_node(node).first().copied().unwrap_or(0) as usize;
             return Err(SolverError::NonFinite {
@@ -414,6 +423,11 @@ impl Solver {
                 tet,
             });
         }
+        Ok(())
+    }
+
+    /// σ_vM, det F and the polar rotation of every live tet (PHYSICS.md §1.3).
+    fn compute_stress(&mut self, parallel: bool) {
         let h = self.params.substep();
         let mu = self.lame.mu;
         let (mesh, x, cut) = (&self.mesh, &self.x, &self.cut);
@@ -452,6 +466,10 @@ impl Solver {
                 );
             }
         }
+    }
+
+    /// Count consecutive inverted frames per live tet; error past the limit.
+    pub(crate) fn check_inversion(&mut self) -> Result<(), SolverError> {
         let limit = self.params.max_inverted_frames;
         let mut worst: Option<(usize, u32)> = None;
         for t in 0..self.det_f.len() {
@@ -490,7 +508,8 @@ impl Solver {
         self.release(&over).tets.len()
     }
 
-    fn stats(&self, released_now: usize) -> FrameStats {
+    /// Frame statistics over the live tets (PHYSICS.md §1.3 stress, volume, energy).
+    pub(crate) fn stats(&self, released_now: usize) -> FrameStats {
         let mut max_vm = 0.0f32;
         let mut sum_vm = 0.0f64;
         let mut live = 0usize;

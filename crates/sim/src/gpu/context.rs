@@ -1,0 +1,124 @@
+//! Opening a wgpu device for compute: any adapter (a discrete GPU, or Mesa lavapipe in CI).
+
+/// Why no GPU device could be opened or used.
+#[derive(Debug, Clone, thiserror::Error)]
+#[non_exhaustive]
+pub enum GpuError {
+    /// No adapter: no GPU, no Vulkan/Metal/DX12/GL driver (on Debian, install
+    /// `mesa-vulkan-drivers libvulkan1` for the lavapipe software adapter).
+    #[error(
+        "no GPU adapter found ({0}); install a GPU driver, or mesa-vulkan-drivers and libvulkan1 for the lavapipe software adapter, or use --device cpu"
+    )]
+    NoAdapter(String),
+    /// The adapter refused the device.
+    #[error("the GPU adapter {adapter} refused a compute device: {msg}")]
+    Device {
+        /// Adapter name.
+        adapter: String,
+        /// Cause.
+        msg: String,
+    },
+    /// The mesh is larger than the adapter's buffer limits.
+    #[error("the mesh needs a {needed}-byte buffer but {adapter} allows {limit} bytes per binding")]
+    TooLarge {
+        /// Adapter name.
+        adapter: String,
+        /// Bytes needed.
+        needed: u64,
+        /// Bytes allowed.
+        limit: u64,
+    },
+    /// Reading results back failed (device lost, out of memory).
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+}
+
+/// A device and queue for the compute solver, with what the adapter is.
+#[derive(Debug, Clone)]
+pub struct GpuContext {
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// Adapter name, backend, device type.
+    pub info: wgpu::AdapterInfo,
+    /// Whether GPU timestamps can be taken inside compute passes.
+    pub timestamps: bool,
+    /// Largest storage buffer binding, bytes.
+    pub max_binding: u64,
+}
+
+impl GpuContext {
+    /// Open the first high-performance adapter of any backend (env `WGPU_BACKEND` and
+    /// friends are honoured), with the limits the solver needs.
+    pub fn new() -> Result<Self, GpuError> {
+        pollster::block_on(Self::open())
+    }
+
+    async fn open() -> Result<Self, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter: false,
+                compatible_surface: None,
+                apply_limit_buckets: false,
+            })
+            .await
+            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let available = adapter.limits();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        let required_limits = wgpu::Limits {
+            max_storage_buffers_per_shader_stage: 8,
+            max_storage_buffer_binding_size: available.max_storage_buffer_binding_size,
+            max_buffer_size: available.max_buffer_size,
+            max_compute_workgroups_per_dimension: available.max_compute_workgroups_per_dimension,
+            ..wgpu::Limits::downlevel_defaults()
+        };
+        if available.max_storage_buffers_per_shader_stage < 8 {
+            return Err(GpuError::Device {
+                adapter: info.name.clone(),
+                msg: format!(
+                    "it allows {} storage buffers per shader stage; the stress kernel needs 8",
+                    available.max_storage_buffers_per_shader_stage
+                ),
+            });
+        }
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("incise compute"),
+                required_features,
+                required_limits,
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| GpuError::Device {
+                adapter: info.name.clone(),
+                msg: e.to_string(),
+            })?;
+        Ok(GpuContext {
+            device,
+            queue,
+            max_binding: available.max_storage_buffer_binding_size as u64,
+            info,
+            timestamps,
+        })
+    }
+
+    /// "name (backend, device type)" for reports.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+}

@@ -1,0 +1,77 @@
+//! The WGSL kernels: sources (common.wgsl prepended to each stage) and compiled pipelines.
+
+/// The compute stages, in the order a frame runs them; each is `shaders/<name>.wgsl`.
+pub const SHADER_STAGES: [&str; 5] = ["predict", "neo_hookean", "velocity", "stress", "release"];
+
+const COMMON: &str = include_str!("../../../../shaders/common.wgsl");
+
+/// Full WGSL source of a stage (common definitions + the stage), or `None` if unknown.
+pub fn shader_source(stage: &str) -> Option<String> {
+    let body = match stage {
+        "predict" => include_str!("../../../../shaders/predict.wgsl"),
+        "neo_hookean" => include_str!("../../../../shaders/neo_hookean.wgsl"),
+        "velocity" => include_str!("../../../../shaders/velocity.wgsl"),
+        "stress" => include_str!("../../../../shaders/stress.wgsl"),
+        "release" => include_str!("../../../../shaders/release.wgsl"),
+        _ => return None,
+    };
+    Some(format!("{COMMON}\n{body}"))
+}
+
+/// One compute pipeline per stage.
+pub(crate) struct Kernels {
+    pub predict: wgpu::ComputePipeline,
+    pub project: wgpu::ComputePipeline,
+    pub velocity: wgpu::ComputePipeline,
+    pub stress: wgpu::ComputePipeline,
+    pub release: wgpu::ComputePipeline,
+}
+
+impl Kernels {
+    /// Compile every stage (layouts are derived from the shaders).
+    pub fn new(device: &wgpu::Device) -> Self {
+        let make = |stage: &str| {
+            let src = shader_source(stage).unwrap_or_default();
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(stage),
+                source: wgpu::ShaderSource::Wgsl(src.into()),
+            });
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(stage),
+                layout: None,
+                module: &module,
+                entry_point: Some("main"),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Kernels {
+            predict: make("predict"),
+            project: make("neo_hookean"),
+            velocity: make("velocity"),
+            stress: make("stress"),
+            release: make("release"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every stage parses and validates with naga, without an adapter.
+    #[test]
+    fn all_shaders_validate_with_naga() {
+        for stage in SHADER_STAGES {
+            let src = shader_source(stage).unwrap();
+            let module = wgpu::naga::front::wgsl::parse_str(&src)
+                .unwrap_or_else(|e| panic!("{stage}.wgsl: {}", e.emit_to_string(&src)));
+            wgpu::naga::valid::Validator::new(
+                wgpu::naga::valid::ValidationFlags::all(),
+                wgpu::naga::valid::Capabilities::empty(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{stage}.wgsl: {}", e.emit_to_string(&src)));
+        }
+    }
+}

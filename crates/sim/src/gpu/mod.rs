@@ -1,0 +1,13 @@
+//! The XPBD solver on the GPU (wgpu compute, kernels in `shaders/`): prediction, coloured
+//! Neo-Hookean projection, velocity update, stress and release run on the device with no
+//! per-substep readback. The CPU solver is the reference it must match; it also serves as
+//! the host mirror (mesh, cut state, guards, statistics), so those exist once.
+
+mod context;
+mod kernels;
+mod layout;
+mod solver;
+
+pub use context::{GpuContext, GpuError};
+pub use kernels::{SHADER_STAGES, shader_source};
+pub use solver::{GpuSolver, GpuTiming};

@@ -1,0 +1,672 @@
+//! `GpuSolver`: persistent device buffers and one command encoder per frame (all substeps,
+//! all colours, stress and release), with the CPU `Solver` as host mirror.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use super::kernels::Kernels;
+use super::layout::{
+    KIND_FREE, KIND_GRAB0, KIND_PINNED, KIND_RETIRED, Params, STEP_STRIDE, Step, TetRest,
+};
+use super::{GpuContext, GpuError};
+use crate::Solver;
+use crate::xpbd::{FrameStats, NodeKind, SolverError, TetProjection};
+
+const WG: u32 = 64;
+
+/// GPU time of the last frame, when the adapter supports timestamps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GpuTiming {
+    /// Kernel time of the whole frame (all substeps + stress + release), ms.
+    pub frame_ms: f64,
+}
+
+/// Device buffers of one body.
+struct Buffers {
+    params: wgpu::Buffer,
+    steps: wgpu::Buffer,
+    pos: wgpu::Buffer,
+    prev: wgpu::Buffer,
+    vel: wgpu::Buffer,
+    start: wgpu::Buffer,
+    kind: wgpu::Buffer,
+    grab_offsets: wgpu::Buffer,
+    tets: wgpu::Buffer,
+    rest: wgpu::Buffer,
+    live: wgpu::Buffer,
+    lambda: wgpu::Buffer,
+    von_mises: wgpu::Buffer,
+    det_f: wgpu::Buffer,
+    rotation: wgpu::Buffer,
+    released_count: wgpu::Buffer,
+    released_list: wgpu::Buffer,
+    saved_pos: wgpu::Buffer,
+    saved_vel: wgpu::Buffer,
+}
+
+/// Bind groups for every dispatch of a frame.
+struct Bindings {
+    predict: wgpu::BindGroup,
+    predict_steps: Vec<wgpu::BindGroup>,
+    project: wgpu::BindGroup,
+    project_steps: Vec<wgpu::BindGroup>,
+    velocity: wgpu::BindGroup,
+    stress: wgpu::BindGroup,
+    release: wgpu::BindGroup,
+}
+
+/// Mappable copies of what the host reads each frame.
+struct Readback {
+    pos: wgpu::Buffer,
+    vel: wgpu::Buffer,
+    von_mises: wgpu::Buffer,
+    det_f: wgpu::Buffer,
+    released: wgpu::Buffer,
+}
+
+struct Timestamps {
+    queries: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+    period_ns: f32,
+}
+
+/// The XPBD solver on a wgpu device. Set pins and grabs on the CPU [`Solver`] first, then
+/// move it onto the device with [`GpuSolver::new`]; accessors for positions, stress and
+/// the cut state are those of the host mirror ([`GpuSolver::host`]), refreshed each frame.
+pub struct GpuSolver {
+    host: Solver,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    adapter: String,
+    kernels: Kernels,
+    buf: Buffers,
+    bind: Bindings,
+    read: Readback,
+    timestamps: Option<Timestamps>,
+    last_timing: Option<GpuTiming>,
+    offsets: Vec<[f32; 4]>,
+}
+
+fn storage(
+    device: &wgpu::Device,
+    label: &str,
+    bytes: &[u8],
+    extra: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytes,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST
+            | extra,
+    })
+}
+
+fn staging(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+fn groups(n: usize) -> u32 {
+    (n as u32).div_ceil(WG)
+}
+
+fn kind_code(k: NodeKind) -> u32 {
+    match k {
+        NodeKind::Free => KIND_FREE,
+        NodeKind::Pinned => KIND_PINNED,
+        NodeKind::Retired => KIND_RETIRED,
+        NodeKind::Grabbed(g) => KIND_GRAB0 + g,
+    }
+}
+
+fn entries<'a>(list: &[&'a wgpu::Buffer]) -> Vec<wgpu::BindGroupEntry<'a>> {
+    list.iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect()
+}
+
+impl GpuSolver {
+    /// Upload `host`'s state (mesh, rest data, colouring, pins, grabs) to the device.
+    pub fn new(host: Solver, ctx: &GpuContext) -> Result<Self, GpuError> {
+        let device = ctx.device.clone();
+        let queue = ctx.queue.clone();
+        let n = host.x.len();
+        let slots = host.slots.len();
+        let needed = (slots * std::mem::size_of::<TetRest>()).max(n * 16) as u64;
+        if needed > ctx.max_binding {
+            return Err(GpuError::TooLarge {
+                adapter: ctx.info.name.clone(),
+                needed,
+                limit: ctx.max_binding,
+            });
+        }
+        let kernels = Kernels::new(&device);
+        let pos: Vec<[f32; 4]> = host
+            .x
+            .iter()
+            .zip(&host.inv_mass)
+            .map(|(p, &w)| [p.x, p.y, p.z, w])
+            .collect();
+        let vec4 =
+            |v: &[Vec3]| -> Vec<[f32; 4]> { v.iter().map(|p| [p.x, p.y, p.z, 0.0]).collect() };
+        let kinds: Vec<u32> = host.kind.iter().map(|&k| kind_code(k)).collect();
+        let tets: Vec<[u32; 4]> = host.slots.iter().map(|s| s.nodes).collect();
+        let rest: Vec<TetRest> = host
+            .slots
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let m = s.terms.dm_inv;
+                let v = host.mesh.rest_volume[host.tet_of_slot[i] as usize];
+                TetRest {
+                    c0: [m.x_axis.x, m.x_axis.y, m.x_axis.z, s.terms.alpha_h],
+                    c1: [m.y_axis.x, m.y_axis.y, m.y_axis.z, s.terms.alpha_d],
+                    c2: [m.z_axis.x, m.z_axis.y, m.z_axis.z, v],
+                }
+            })
+            .collect();
+        let live: Vec<u32> = host.slots.iter().map(|s| s.live as u32).collect();
+        let rot: Vec<[f32; 4]> = host
+            .tet_of_slot
+            .iter()
+            .map(|&t| host.rotation[t as usize].to_array())
+            .collect();
+        let p = &host.params;
+        let h = p.substep();
+        let params = Params {
+            gravity: p.gravity.to_array(),
+            h,
+            inv_h: 1.0 / h,
+            keep: (1.0 - p.damping * h).max(0.0),
+            gamma: 1.0 + host.lame.mu / host.lame.lambda,
+            mu: host.lame.mu,
+            threshold: p.release_threshold.unwrap_or(0.0),
+            node_count: n as u32,
+            slot_count: slots as u32,
+            grab_count: host.grabs.len() as u32,
+            mode: match p.projection {
+                TetProjection::Coupled => 0,
+                TetProjection::Sequential => 1,
+            },
+            pad: [0; 3],
+        };
+        // Step records: one per substep (prediction), then one per colour.
+        let substeps = p.substeps as usize;
+        let colours = host.color_ranges.len();
+        let mut step_bytes = vec![0u8; (substeps + colours) * STEP_STRIDE as usize];
+        let mut put = |k: usize, s: Step| {
+            let o = k * STEP_STRIDE as usize;
+            step_bytes[o..o + 16].copy_from_slice(bytemuck::bytes_of(&s));
+        };
+        for s in 0..substeps {
+            put(
+                s,
+                Step {
+                    first: 0,
+                    count: n as u32,
+                    substep: s as u32,
+                    pad: 0,
+                },
+            );
+        }
+        for (c, r) in host.color_ranges.iter().enumerate() {
+            put(
+                substeps + c,
+                Step {
+                    first: r.start as u32,
+                    count: r.len() as u32,
+                    substep: 0,
+                    pad: 0,
+                },
+            );
+        }
+        let none = wgpu::BufferUsages::empty();
+        let pos_b = storage(&device, "pos", bytemuck::cast_slice(&pos), none);
+        let buf = Buffers {
+            params: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            }),
+            steps: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("steps"),
+                contents: &step_bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            prev: storage(&device, "prev", bytemuck::cast_slice(&pos), none),
+            saved_pos: storage(&device, "saved pos", bytemuck::cast_slice(&pos), none),
+            pos: pos_b,
+            vel: storage(&device, "vel", bytemuck::cast_slice(&vec4(&host.v)), none),
+            saved_vel: storage(
+                &device,
+                "saved vel",
+                bytemuck::cast_slice(&vec4(&host.v)),
+                none,
+            ),
+            start: storage(
+                &device,
+                "start",
+                bytemuck::cast_slice(&vec4(&host.start)),
+                none,
+            ),
+            kind: storage(&device, "kind", bytemuck::cast_slice(&kinds), none),
+            grab_offsets: storage(
+                &device,
+                "grab offsets",
+                &vec![0u8; (substeps * host.grabs.len().max(1) * 16).max(16)],
+                none,
+            ),
+            tets: storage(&device, "tets", bytemuck::cast_slice(&tets), none),
+            rest: storage(&device, "rest", bytemuck::cast_slice(&rest), none),
+            live: storage(&device, "live", bytemuck::cast_slice(&live), none),
+            lambda: storage(&device, "lambda_h", &vec![0u8; slots * 4], none),
+            von_mises: storage(&device, "von mises", &vec![0u8; slots * 4], none),
+            det_f: storage(
+                &device,
+                "det F",
+                bytemuck::cast_slice(&vec![1.0f32; slots]),
+                none,
+            ),
+            rotation: storage(&device, "rotation", bytemuck::cast_slice(&rot), none),
+            released_count: storage(&device, "released count", &[0u8; 4], none),
+            released_list: storage(&device, "released list", &vec![0u8; slots * 4], none),
+        };
+        let b = &buf;
+        let group =
+            |pipe: &wgpu::ComputePipeline, index: u32, list: &[&wgpu::Buffer], label: &str| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(label),
+                    layout: &pipe.get_bind_group_layout(index),
+                    entries: &entries(list),
+                })
+            };
+        let step_group = |pipe: &wgpu::ComputePipeline, k: usize| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("step"),
+                layout: &pipe.get_bind_group_layout(1),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &b.steps,
+                        offset: k as u64 * STEP_STRIDE,
+                        size: wgpu::BufferSize::new(16),
+                    }),
+                }],
+            })
+        };
+        let bind = Bindings {
+            predict: group(
+                &kernels.predict,
+                0,
+                &[
+                    &b.params,
+                    &b.pos,
+                    &b.prev,
+                    &b.vel,
+                    &b.start,
+                    &b.kind,
+                    &b.grab_offsets,
+                ],
+                "predict",
+            ),
+            predict_steps: (0..substeps)
+                .map(|s| step_group(&kernels.predict, s))
+                .collect(),
+            project: group(
+                &kernels.project,
+                0,
+                &[&b.params, &b.pos, &b.tets, &b.rest, &b.live, &b.lambda],
+                "project",
+            ),
+            project_steps: (0..colours)
+                .map(|c| step_group(&kernels.project, substeps + c))
+                .collect(),
+            velocity: group(
+                &kernels.velocity,
+                0,
+                &[&b.params, &b.pos, &b.prev, &b.vel, &b.kind],
+                "velocity",
+            ),
+            stress: group(
+                &kernels.stress,
+                0,
+                &[
+                    &b.params,
+                    &b.pos,
+                    &b.tets,
+                    &b.rest,
+                    &b.live,
+                    &b.lambda,
+                    &b.von_mises,
+                    &b.det_f,
+                    &b.rotation,
+                ],
+                "stress",
+            ),
+            release: group(
+                &kernels.release,
+                0,
+                &[
+                    &b.params,
+                    &b.von_mises,
+                    &b.live,
+                    &b.released_count,
+                    &b.released_list,
+                ],
+                "release",
+            ),
+        };
+        let read = Readback {
+            pos: staging(&device, "read pos", n as u64 * 16),
+            vel: staging(&device, "read vel", n as u64 * 16),
+            von_mises: staging(&device, "read von mises", slots as u64 * 4),
+            det_f: staging(&device, "read det F", slots as u64 * 4),
+            released: staging(&device, "read released", 4 + slots as u64 * 4),
+        };
+        let timestamps = ctx.timestamps.then(|| Timestamps {
+            queries: device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("frame timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            }),
+            resolve: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamp resolve"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            read: staging(&device, "read timestamps", 16),
+            period_ns: queue.get_timestamp_period(),
+        });
+        Ok(GpuSolver {
+            adapter: ctx.describe(),
+            offsets: vec![[0.0; 4]; substeps * host.grabs.len().max(1)],
+            host,
+            device,
+            queue,
+            kernels,
+            buf,
+            bind,
+            read,
+            timestamps,
+            last_timing: None,
+        })
+    }
+
+    /// The host mirror: mesh, cut state, positions, velocities, stress of the last frame.
+    pub fn host(&self) -> &Solver {
+        &self.host
+    }
+
+    /// Adapter name, backend and type.
+    pub fn adapter(&self) -> &str {
+        &self.adapter
+    }
+
+    /// Kernel time of the last frame, where the adapter has timestamps.
+    pub fn last_timing(&self) -> Option<GpuTiming> {
+        self.last_timing
+    }
+
+    /// The device's position buffer (`vec4<f32>` per node: xyz, inverse mass), for
+    /// renderers that read positions without a round trip.
+    pub fn position_buffer(&self) -> &wgpu::Buffer {
+        &self.buf.pos
+    }
+
+    /// Per-tet "live" flags on the device (`u32` per tet in colour order).
+    pub fn live_buffer(&self) -> &wgpu::Buffer {
+        &self.buf.live
+    }
+
+    /// Advance one frame on the device; then read positions, velocities, stress and the
+    /// tets released this frame back into the host mirror, run the guards and update the
+    /// cut state. On a guard failure the frame is rolled back on both sides.
+    pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
+        let t0 = Instant::now();
+        self.upload_grab_offsets();
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
+        let (n, slots) = (self.host.x.len() as u64, self.host.slots.len() as u64);
+        enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.buf.saved_pos, 0, n * 16);
+        enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.buf.saved_vel, 0, n * 16);
+        enc.clear_buffer(&self.buf.released_count, 0, None);
+        self.record_frame(&mut enc);
+        enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.read.pos, 0, n * 16);
+        enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.read.vel, 0, n * 16);
+        enc.copy_buffer_to_buffer(&self.buf.von_mises, 0, &self.read.von_mises, 0, slots * 4);
+        enc.copy_buffer_to_buffer(&self.buf.det_f, 0, &self.read.det_f, 0, slots * 4);
+        enc.copy_buffer_to_buffer(&self.buf.released_count, 0, &self.read.released, 0, 4);
+        enc.copy_buffer_to_buffer(
+            &self.buf.released_list,
+            0,
+            &self.read.released,
+            4,
+            slots * 4,
+        );
+        if let Some(ts) = &self.timestamps {
+            enc.resolve_query_set(&ts.queries, 0..2, &ts.resolve, 0);
+            enc.copy_buffer_to_buffer(&ts.resolve, 0, &ts.read, 0, 16);
+        }
+        self.queue.submit([enc.finish()]);
+        let t1 = Instant::now();
+        let released = self
+            .read_back()
+            .map_err(|e| SolverError::Device(e.to_string()))?;
+        let solve_ms = (t1 - t0).as_secs_f64() * 1e3;
+        self.host.time += self.host.params.frame_dt as f64;
+        let guard = self
+            .host
+            .check_finite()
+            .and_then(|_| self.host.check_inversion());
+        if let Err(e) = guard {
+            self.roll_back();
+            return Err(e);
+        }
+        let mesh_tets: Vec<u32> = released
+            .iter()
+            .map(|&s| self.host.tet_of_slot[s as usize])
+            .collect();
+        let ev = self.host.release(&mesh_tets);
+        self.retire_on_device(&ev.retired_nodes);
+        let mut stats = self.host.stats(ev.tets.len());
+        stats.solve_ms = solve_ms;
+        stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
+        self.host.frame += 1;
+        Ok(stats)
+    }
+
+    fn upload_grab_offsets(&mut self) {
+        let grabs = &self.host.grabs;
+        if grabs.is_empty() {
+            return;
+        }
+        let h = self.host.params.substep() as f64;
+        for s in 0..self.host.params.substeps as usize {
+            let t = self.host.time + (s + 1) as f64 * h;
+            for (g, grab) in grabs.iter().enumerate() {
+                let o = grab.offset_at(t);
+                self.offsets[s * grabs.len() + g] = [o.x, o.y, o.z, 0.0];
+            }
+        }
+        self.queue.write_buffer(
+            &self.buf.grab_offsets,
+            0,
+            bytemuck::cast_slice(&self.offsets),
+        );
+    }
+
+    /// All dispatches of one frame in one compute pass.
+    fn record_frame(&self, enc: &mut wgpu::CommandEncoder) {
+        let n = self.host.x.len();
+        let timestamp_writes =
+            self.timestamps
+                .as_ref()
+                .map(|ts| wgpu::ComputePassTimestampWrites {
+                    query_set: &ts.queries,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                });
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("xpbd frame"),
+            timestamp_writes,
+        });
+        let k = &self.kernels;
+        for s in 0..self.host.params.substeps as usize {
+            pass.set_pipeline(&k.predict);
+            pass.set_bind_group(0, &self.bind.predict, &[]);
+            pass.set_bind_group(1, &self.bind.predict_steps[s], &[]);
+            pass.dispatch_workgroups(groups(n), 1, 1);
+            pass.set_pipeline(&k.project);
+            pass.set_bind_group(0, &self.bind.project, &[]);
+            for (c, r) in self.host.color_ranges.iter().enumerate() {
+                pass.set_bind_group(1, &self.bind.project_steps[c], &[]);
+                pass.dispatch_workgroups(groups(r.len()), 1, 1);
+            }
+            pass.set_pipeline(&k.velocity);
+            pass.set_bind_group(0, &self.bind.velocity, &[]);
+            pass.dispatch_workgroups(groups(n), 1, 1);
+        }
+        pass.set_pipeline(&k.stress);
+        pass.set_bind_group(0, &self.bind.stress, &[]);
+        pass.dispatch_workgroups(groups(self.host.slots.len()), 1, 1);
+        pass.set_pipeline(&k.release);
+        pass.set_bind_group(0, &self.bind.release, &[]);
+        pass.dispatch_workgroups(groups(self.host.slots.len()), 1, 1);
+    }
+
+    /// Map the staging buffers, copy into the host mirror; returns released slots.
+    fn read_back(&mut self) -> Result<Vec<u32>, GpuError> {
+        let mut bufs = vec![
+            &self.read.pos,
+            &self.read.vel,
+            &self.read.von_mises,
+            &self.read.det_f,
+            &self.read.released,
+        ];
+        if let Some(ts) = &self.timestamps {
+            bufs.push(&ts.read);
+        }
+        for b in &bufs {
+            b.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+        }
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let view = |b: &wgpu::Buffer| -> Result<Vec<u8>, GpuError> {
+            let v = b
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Readback(e.to_string()))?;
+            let out = v.to_vec();
+            drop(v);
+            b.unmap();
+            Ok(out)
+        };
+        let pos = view(&self.read.pos)?;
+        let vel = view(&self.read.vel)?;
+        let vm = view(&self.read.von_mises)?;
+        let det = view(&self.read.det_f)?;
+        let rel = view(&self.read.released)?;
+        if let Some(ts) = &self.timestamps {
+            let t = view(&ts.read)?;
+            let q: &[u64] = bytemuck::cast_slice(&t);
+            self.last_timing = Some(GpuTiming {
+                frame_ms: q[1].wrapping_sub(q[0]) as f64 * ts.period_ns as f64 * 1e-6,
+            });
+        }
+        let pos: &[[f32; 4]] = bytemuck::cast_slice(&pos);
+        let vel: &[[f32; 4]] = bytemuck::cast_slice(&vel);
+        for (i, (p, v)) in pos.iter().zip(vel).enumerate() {
+            self.host.x[i] = Vec3::new(p[0], p[1], p[2]);
+            self.host.v[i] = Vec3::new(v[0], v[1], v[2]);
+        }
+        let vm: &[f32] = bytemuck::cast_slice(&vm);
+        let det: &[f32] = bytemuck::cast_slice(&det);
+        for (s, &t) in self.host.tet_of_slot.iter().enumerate() {
+            self.host.von_mises[t as usize] = vm[s];
+            if self.host.cut.is_live(t as usize) {
+                self.host.det_f[t as usize] = det[s];
+            }
+        }
+        let words: &[u32] = bytemuck::cast_slice(&rel);
+        let count = (words[0] as usize).min(words.len() - 1);
+        let mut released = words[1..1 + count].to_vec();
+        released.sort_unstable();
+        Ok(released)
+    }
+
+    /// Restore the frame's starting positions and velocities on both sides.
+    fn roll_back(&mut self) {
+        let n = self.host.x.len() as u64;
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("rollback"),
+            });
+        enc.copy_buffer_to_buffer(&self.buf.saved_pos, 0, &self.buf.pos, 0, n * 16);
+        enc.copy_buffer_to_buffer(&self.buf.saved_vel, 0, &self.buf.vel, 0, n * 16);
+        enc.copy_buffer_to_buffer(&self.buf.saved_pos, 0, &self.read.pos, 0, n * 16);
+        enc.copy_buffer_to_buffer(&self.buf.saved_vel, 0, &self.read.vel, 0, n * 16);
+        self.queue.submit([enc.finish()]);
+        let _ = self.read_state_only();
+        self.host.time -= self.host.params.frame_dt as f64;
+    }
+
+    fn read_state_only(&mut self) -> Result<(), GpuError> {
+        for b in [&self.read.pos, &self.read.vel] {
+            b.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+        }
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        for (b, dst) in [
+            (&self.read.pos, &mut self.host.x),
+            (&self.read.vel, &mut self.host.v),
+        ] {
+            let v = b
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Readback(e.to_string()))?;
+            let a: &[[f32; 4]] = bytemuck::cast_slice(&v);
+            for (d, p) in dst.iter_mut().zip(a) {
+                *d = Vec3::new(p[0], p[1], p[2]);
+            }
+            drop(v);
+            b.unmap();
+        }
+        Ok(())
+    }
+
+    /// Mark newly retired nodes on the device (frozen, zero velocity).
+    fn retire_on_device(&self, nodes: &[u32]) {
+        for &i in nodes {
+            self.queue.write_buffer(
+                &self.buf.kind,
+                i as u64 * 4,
+                bytemuck::bytes_of(&KIND_RETIRED),
+            );
+            self.queue.write_buffer(
+                &self.buf.vel,
+                i as u64 * 16,
+                bytemuck::bytes_of(&[0.0f32; 4]),
+            );
+        }
+    }
+}

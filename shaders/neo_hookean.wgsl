@@ -1,0 +1,141 @@
+// Neo-Hookean constraint projection of one colour (PHYSICS.md §1.2, Macklin & Müller 2021):
+// C_D = ||F||_F, C_H = det F - gamma, coupled 2x2 solve (default) or H then D. Tets of one
+// colour share no node, so each invocation owns its four nodes.
+// CPU twin: crates/sim/src/xpbd/neo_hookean.rs (same operations in the same order).
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var<storage, read_write> pos: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> tets: array<vec4<u32>>;
+@group(0) @binding(3) var<storage, read> rest: array<TetRest>;
+@group(0) @binding(4) var<storage, read> live: array<u32>;
+@group(0) @binding(5) var<storage, read_write> lambda_h: array<f32>;
+@group(1) @binding(0) var<uniform> S: Step;
+
+// PHYSICS.md §1.2, table row C_H: d det F / dF = [f2 x f3, f3 x f1, f1 x f2].
+fn det_gradient(f: mat3x3<f32>) -> mat3x3<f32> {
+    return mat3x3<f32>(cross(f[1], f[2]), cross(f[2], f[0]), cross(f[0], f[1]));
+}
+
+var<private> g_a: array<vec3<f32>, 4>;
+var<private> g_b: array<vec3<f32>, 4>;
+var<private> x: array<vec3<f32>, 4>;
+var<private> w: array<f32, 4>;
+
+// Vertex gradients G = (dC/dF) Dm^-T: columns are grad x1..x3, grad x0 = -(sum).
+fn gradients_a(dcdf: mat3x3<f32>, dm_inv: mat3x3<f32>) {
+    let g = dcdf * transpose(dm_inv);
+    g_a[0] = -(g[0] + g[1] + g[2]);
+    g_a[1] = g[0];
+    g_a[2] = g[1];
+    g_a[3] = g[2];
+}
+
+fn gradients_b(dcdf: mat3x3<f32>, dm_inv: mat3x3<f32>) {
+    let g = dcdf * transpose(dm_inv);
+    g_b[0] = -(g[0] + g[1] + g[2]);
+    g_b[1] = g[0];
+    g_b[2] = g[1];
+    g_b[3] = g[2];
+}
+
+fn dot_aa() -> f32 {
+    return w[0] * dot(g_a[0], g_a[0]) + w[1] * dot(g_a[1], g_a[1]) + w[2] * dot(g_a[2], g_a[2]) + w[3] * dot(g_a[3], g_a[3]);
+}
+
+fn dot_ab() -> f32 {
+    return w[0] * dot(g_a[0], g_b[0]) + w[1] * dot(g_a[1], g_b[1]) + w[2] * dot(g_a[2], g_b[2]) + w[3] * dot(g_a[3], g_b[3]);
+}
+
+fn dot_bb() -> f32 {
+    return w[0] * dot(g_b[0], g_b[0]) + w[1] * dot(g_b[1], g_b[1]) + w[2] * dot(g_b[2], g_b[2]) + w[3] * dot(g_b[3], g_b[3]);
+}
+
+fn frobenius(f: mat3x3<f32>) -> f32 {
+    return sqrt(dot(f[0], f[0]) + dot(f[1], f[1]) + dot(f[2], f[2]));
+}
+
+// One scalar XPBD update along g_a: dl = -C / (sum w |grad|^2 + alpha~).
+fn apply_scalar_a(c: f32, alpha: f32) -> f32 {
+    let denom = dot_aa() + alpha;
+    if (!(denom > 0.0)) {
+        return 0.0;
+    }
+    let dl = -c / denom;
+    for (var i = 0; i < 4; i++) {
+        x[i] += w[i] * g_a[i] * dl;
+    }
+    return dl;
+}
+
+fn project_coupled(dm_inv: mat3x3<f32>, alpha_h: f32, alpha_d: f32) -> f32 {
+    let f = deformation_gradient(x[0], x[1], x[2], x[3], dm_inv);
+    let c_h = determinant(f) - P.gamma;
+    gradients_a(det_gradient(f), dm_inv);
+    let norm = frobenius(f);
+    if (norm < 1e-12) {
+        return apply_scalar_a(c_h, alpha_h);
+    }
+    let c_d = norm;
+    gradients_b(f * (1.0 / norm), dm_inv);
+    var a = dot_aa() + alpha_h;
+    var b = dot_ab();
+    var d = dot_bb() + alpha_d;
+    let s = 1.0 / (a + d);
+    a *= s;
+    b *= s;
+    d *= s;
+    let det = a * d - b * b;
+    if (!(det > 0.0)) {
+        return 0.0;
+    }
+    let r1 = -c_h * s;
+    let r2 = -c_d * s;
+    let dl_h = (r1 * d - b * r2) / det;
+    let dl_d = (a * r2 - b * r1) / det;
+    for (var i = 0; i < 4; i++) {
+        x[i] += w[i] * (g_a[i] * dl_h + g_b[i] * dl_d);
+    }
+    return dl_h;
+}
+
+fn project_sequential(dm_inv: mat3x3<f32>, alpha_h: f32, alpha_d: f32) -> f32 {
+    var f = deformation_gradient(x[0], x[1], x[2], x[3], dm_inv);
+    gradients_a(det_gradient(f), dm_inv);
+    let dl_h = apply_scalar_a(determinant(f) - P.gamma, alpha_h);
+    f = deformation_gradient(x[0], x[1], x[2], x[3], dm_inv);
+    let norm = frobenius(f);
+    if (norm >= 1e-12) {
+        gradients_a(f * (1.0 / norm), dm_inv);
+        apply_scalar_a(norm, alpha_d);
+    }
+    return dl_h;
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= S.count) {
+        return;
+    }
+    let slot = S.first + gid.x;
+    if (live[slot] == 0u) {
+        return;
+    }
+    let idx = tets[slot];
+    for (var i = 0; i < 4; i++) {
+        let p = pos[idx[i]];
+        x[i] = p.xyz;
+        w[i] = p.w;
+    }
+    let r = rest[slot];
+    let dm_inv = dm_inv_of(r);
+    var dl_h: f32;
+    if (P.mode == 0u) {
+        dl_h = project_coupled(dm_inv, r.c0.w, r.c1.w);
+    } else {
+        dl_h = project_sequential(dm_inv, r.c0.w, r.c1.w);
+    }
+    lambda_h[slot] = dl_h;
+    for (var i = 0; i < 4; i++) {
+        pos[idx[i]] = vec4<f32>(x[i], w[i]);
+    }
+}

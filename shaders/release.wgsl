@@ -1,0 +1,23 @@
+// Release by the von Mises criterion (PHYSICS.md §1.4, seed eq. 5): a live tet whose
+// stress exceeds the threshold loses its constraints (a flag; nothing is deleted) and is
+// appended to the list of tets released this frame, which the host reads back to update
+// the cut surface. CPU twin: Solver::release_overstressed.
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var<storage, read> von_mises: array<f32>;
+@group(0) @binding(2) var<storage, read_write> live: array<u32>;
+@group(0) @binding(3) var<storage, read_write> released_count: atomic<u32>;
+@group(0) @binding(4) var<storage, read_write> released_list: array<u32>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let slot = gid.x;
+    if (slot >= P.slot_count || P.threshold <= 0.0) {
+        return;
+    }
+    if (live[slot] != 0u && von_mises[slot] > P.threshold) {
+        live[slot] = 0u;
+        let k = atomicAdd(&released_count, 1u);
+        released_list[k] = slot;
+    }
+}
