@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs what building incise needs on a fresh Debian/Ubuntu machine, only if missing:
-# a C toolchain and curl (apt), and Rust with rustfmt and clippy (rustup).
+# Installs what building and testing incise needs on a fresh Debian/Ubuntu machine, only if
+# missing: a C toolchain, curl, the Vulkan loader and Mesa's drivers (apt), and Rust with
+# rustfmt and clippy (rustup).
 set -euo pipefail
 
 apt_install() {
@@ -14,6 +15,9 @@ missing=()
 command -v cc >/dev/null 2>&1 || missing+=(build-essential)
 command -v curl >/dev/null 2>&1 || missing+=(curl ca-certificates)
 command -v pkg-config >/dev/null 2>&1 || missing+=(pkg-config)
+# Vulkan loader + Mesa drivers: the GPU solver runs on any adapter, in CI on lavapipe.
+ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1 || missing+=(mesa-vulkan-drivers)
+ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' || missing+=(libvulkan1)
 if [ ${#missing[@]} -gt 0 ]; then
     echo "installing system packages: ${missing[*]}"
     apt_install "${missing[@]}"
@@ -31,4 +35,10 @@ fi
 if command -v rustup >/dev/null 2>&1; then
     rustup component list --installed 2>/dev/null | grep -q '^rustfmt' || rustup component add rustfmt
     rustup component list --installed 2>/dev/null | grep -q '^clippy' || rustup component add clippy
+fi
+
+# wgpu/Mesa print "XDG_RUNTIME_DIR is invalid" without one; give them a private one.
+if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "${XDG_RUNTIME_DIR}" ]; then
+    XDG_RUNTIME_DIR="$(mktemp -d)"
+    export XDG_RUNTIME_DIR
 fi

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use crate::body::DeviceChoice;
+
 /// incise: mixed-reality surgical cutting trainer (headless runner, mesh tools, benchmarks).
 #[derive(Debug, Parser)]
 #[command(name = "incise", version, about)]
@@ -35,6 +37,9 @@ pub enum Command {
         /// No progress output.
         #[arg(long)]
         quiet: bool,
+        /// Where the solver runs (auto: the GPU when an adapter exists, else the CPU).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
     },
     /// Mesh tools.
     Mesh {
@@ -42,7 +47,7 @@ pub enum Command {
         #[command(subcommand)]
         command: MeshCommand,
     },
-    /// Time the solver on the plate and the 34k-tet intestine, serial and all threads.
+    /// Time the solver (10 substeps per frame) on the plate and the 34k-tet intestine.
     Bench {
         /// Print one JSON object instead of a table.
         #[arg(long)]
@@ -53,6 +58,12 @@ pub enum Command {
         /// Which cases to run.
         #[arg(long, value_enum, default_value_t = BenchCase::All)]
         case: BenchCase,
+        /// Where the solver runs (cpu: serial and all threads).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Cpu)]
+        device: DeviceChoice,
+        /// Add the intestine scaling series (≈140k, 550k, 1.1M tets).
+        #[arg(long)]
+        scaling: bool,
     },
 }
 

@@ -2,6 +2,7 @@
 //! The binary in `main.rs` is a thin CLI over these modules; `tests/` drives both.
 
 pub mod bench;
+pub mod body;
 pub mod cli;
 pub mod mesh_cmd;
 pub mod progress;

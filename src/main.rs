@@ -17,6 +17,7 @@ fn main() -> ExitCode {
             vtu_every,
             threads,
             quiet,
+            device,
         } => run_scene(&RunOptions {
             scene,
             frames,
@@ -24,6 +25,7 @@ fn main() -> ExitCode {
             vtu_every,
             threads,
             quiet,
+            device,
         })
         .map(|o| {
             let last = o.report.frames.last();
@@ -40,7 +42,13 @@ fn main() -> ExitCode {
             MeshCommand::Check { file, json } => mesh_cmd::check(&file, json),
             MeshCommand::Gen { kind, out } => mesh_cmd::generate(kind, &out),
         },
-        Command::Bench { json, frames, case } => bench::run(case, frames, json),
+        Command::Bench {
+            json,
+            frames,
+            case,
+            device,
+            scaling,
+        } => bench::run(case, frames, json, device, scaling),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

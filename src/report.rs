@@ -14,6 +14,9 @@ pub struct FrameRecord {
     pub stats: FrameStats,
     /// Wall time of the frame (substeps + stress + release), ms.
     pub wall_ms: f64,
+    /// GPU kernel time of the frame (timestamps), ms; absent on the CPU or without them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gpu_ms: Option<f64>,
 }
 
 /// The whole run report.
@@ -35,7 +38,7 @@ pub struct Report {
     pub solver: incise_sim::SolverParams,
     /// Worker threads used.
     pub threads: usize,
-    /// Device the solver ran on.
+    /// Device the solver ran on: "cpu" or the GPU adapter's name, backend and type.
     pub device: String,
     /// Per-frame records.
     pub frames: Vec<FrameRecord>,

@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
 
+use crate::body::{Body, DeviceChoice};
 use crate::progress::Progress;
 use crate::report::{FrameRecord, MaterialInfo, MeshInfo, Report};
 use crate::scene::{BuiltScene, build_scene, load_scene};
@@ -27,6 +28,8 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Suppress progress output.
     pub quiet: bool,
+    /// Where the solver runs.
+    pub device: DeviceChoice,
 }
 
 /// What a finished run produced.
@@ -43,7 +46,7 @@ pub struct RunOutcome {
 pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let scene = load_scene(&opts.scene)?;
     let BuiltScene {
-        mut solver,
+        solver,
         skin,
         material,
         material_name,
@@ -51,8 +54,15 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         pinned_nodes,
         grabbed_nodes,
     } = build_scene(&scene, &opts.scene, opts.threads)?;
+    let quiet = opts.quiet;
+    let mut body = Body::place(solver, opts.device, |m| {
+        if !quiet {
+            eprintln!("note: {m}");
+        }
+    })?;
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("creating {}", opts.out.display()))?;
+    let solver = body.solver();
     let frames = opts
         .frames
         .unwrap_or_else(|| (scene.duration / solver.params().frame_dt).round().max(1.0) as u64);
@@ -86,20 +96,20 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         },
         solver: solver.params().clone(),
         threads,
-        device: "cpu".into(),
+        device: body.device(),
         frames: Vec::with_capacity(frames as usize),
         snapshots: Vec::new(),
     };
     let report_path = opts.out.join("report.json");
     let mut pvd: Vec<(f64, String)> = Vec::new();
     if opts.vtu_every > 0 {
-        snapshot(&opts.out, &solver, 0, &mut pvd)?;
+        snapshot(&opts.out, body.solver(), 0, &mut pvd)?;
     }
     let progress = (!opts.quiet).then(|| Progress::new(frames, 60));
     let mut failure = None;
     for f in 0..frames {
         let t0 = Instant::now();
-        match solver.step_frame() {
+        match body.step_frame() {
             Ok(stats) => {
                 let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
                 if let Some(p) = &progress {
@@ -110,7 +120,11 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
                         )
                     });
                 }
-                report.frames.push(FrameRecord { stats, wall_ms });
+                report.frames.push(FrameRecord {
+                    stats,
+                    wall_ms,
+                    gpu_ms: body.gpu_frame_ms(),
+                });
             }
             Err(e) => {
                 failure = Some(e);
@@ -118,7 +132,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
             }
         }
         if opts.vtu_every > 0 && (f + 1) % opts.vtu_every == 0 {
-            snapshot(&opts.out, &solver, f + 1, &mut pvd)?;
+            snapshot(&opts.out, body.solver(), f + 1, &mut pvd)?;
         }
     }
     if let Some(p) = &progress {

@@ -193,7 +193,9 @@ fn degenerate_mesh_is_reported_and_rejected() {
 
 #[test]
 fn bench_json_has_the_documented_fields() {
-    let o = incise(&["bench", "--json", "--case", "plate", "--frames", "1"]);
+    let o = incise(&[
+        "bench", "--json", "--case", "plate", "--frames", "1", "--device", "cpu",
+    ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let b: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let r = &b["results"][0];
@@ -247,4 +249,49 @@ fn intestine_pull_tears() {
     let last = report["frames"].as_array().unwrap().last().unwrap().clone();
     assert!(last["released_total"].as_u64().unwrap() > 100, "{last}");
     assert_eq!(report["mesh"]["tets"], 34176);
+}
+
+/// `--device gpu` runs the same scene on the adapter and reports it; the result agrees
+/// with `--device cpu` (same released count). Skipped without an adapter unless
+/// INCISE_REQUIRE_GPU=1.
+#[test]
+fn device_gpu_matches_device_cpu() {
+    if incise_sim::gpu::GpuContext::new().is_err() {
+        assert!(
+            std::env::var("INCISE_REQUIRE_GPU").map_or(true, |v| v != "1"),
+            "INCISE_REQUIRE_GPU=1 but no adapter"
+        );
+        eprintln!("skipping: no GPU adapter");
+        return;
+    }
+    let dir = temp_dir("device");
+    let scene = dir.join("bar.ron");
+    std::fs::write(&scene, BAR).unwrap();
+    let mut released = Vec::new();
+    for device in ["cpu", "gpu"] {
+        let out = dir.join(device);
+        let o = incise(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--device",
+            device,
+            "--vtu-every",
+            "0",
+            "--quiet",
+        ]);
+        assert!(o.status.success(), "{device}: {}", text(&o.stderr));
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        let d = r["device"].as_str().unwrap().to_string();
+        assert!(d.starts_with(device), "{d}");
+        released.push(
+            r["frames"].as_array().unwrap().last().unwrap()["released_total"]
+                .as_u64()
+                .unwrap(),
+        );
+    }
+    assert_eq!(released[0], released[1]);
+    assert!(released[0] > 0);
 }

@@ -465,10 +465,11 @@ impl GpuSolver {
             enc.copy_buffer_to_buffer(&ts.resolve, 0, &ts.read, 0, 16);
         }
         self.queue.submit([enc.finish()]);
-        let t1 = Instant::now();
         let released = self
             .read_back()
             .map_err(|e| SolverError::Device(e.to_string()))?;
+        // Device work ends when the readback completes: that is the frame's solve time.
+        let t1 = Instant::now();
         let solve_ms = (t1 - t0).as_secs_f64() * 1e3;
         self.host.time += self.host.params.frame_dt as f64;
         let guard = self

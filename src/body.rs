@@ -1,0 +1,80 @@
+//! The simulated body on the device the user chose: the CPU reference solver or the GPU
+//! solver (whose host mirror carries the same accessors).
+
+use anyhow::Result;
+use clap::ValueEnum;
+use incise_sim::Solver;
+use incise_sim::gpu::{GpuContext, GpuSolver};
+use incise_sim::xpbd::{FrameStats, SolverError};
+
+/// Where the solver runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DeviceChoice {
+    /// The GPU when an adapter exists, else the CPU with a one-line notice.
+    Auto,
+    /// The CPU reference solver (rayon).
+    Cpu,
+    /// The wgpu compute solver; an error when no adapter exists.
+    Gpu,
+}
+
+/// A solver on the CPU or the GPU.
+pub enum Body {
+    /// CPU reference.
+    Cpu(Box<Solver>),
+    /// GPU compute, with its adapter description.
+    Gpu(Box<GpuSolver>),
+}
+
+impl Body {
+    /// Put `solver` (pins and grabs applied) on the chosen device. `notice` receives the
+    /// line explaining an automatic fall-back to the CPU.
+    pub fn place(solver: Solver, choice: DeviceChoice, notice: impl FnOnce(&str)) -> Result<Body> {
+        match choice {
+            DeviceChoice::Cpu => Ok(Body::Cpu(Box::new(solver))),
+            DeviceChoice::Gpu => {
+                let ctx = GpuContext::new()?;
+                Ok(Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?)))
+            }
+            DeviceChoice::Auto => match GpuContext::new() {
+                Ok(ctx) => Ok(Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?))),
+                Err(e) => {
+                    notice(&format!("{e}; running on the CPU"));
+                    Ok(Body::Cpu(Box::new(solver)))
+                }
+            },
+        }
+    }
+
+    /// Advance one frame.
+    pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
+        match self {
+            Body::Cpu(s) => s.step_frame(),
+            Body::Gpu(g) => g.step_frame(),
+        }
+    }
+
+    /// The CPU solver, or the GPU solver's host mirror (positions, stress, cut state).
+    pub fn solver(&self) -> &Solver {
+        match self {
+            Body::Cpu(s) => s,
+            Body::Gpu(g) => g.host(),
+        }
+    }
+
+    /// "cpu" or the adapter's name, backend and type.
+    pub fn device(&self) -> String {
+        match self {
+            Body::Cpu(_) => "cpu".into(),
+            Body::Gpu(g) => format!("gpu: {}", g.adapter()),
+        }
+    }
+
+    /// GPU kernel time of the last frame, ms, where the adapter has timestamps.
+    pub fn gpu_frame_ms(&self) -> Option<f64> {
+        match self {
+            Body::Cpu(_) => None,
+            Body::Gpu(g) => g.last_timing().map(|t| t.frame_ms),
+        }
+    }
+}
