@@ -41,6 +41,20 @@ pub enum Command {
         #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
         device: DeviceChoice,
     },
+    /// Run a scene on the CPU and the GPU side by side; exit 1 if they disagree.
+    Compare {
+        /// Scene file (RON).
+        scene: PathBuf,
+        /// Frames to compare.
+        #[arg(long, default_value_t = 200)]
+        frames: u64,
+        /// CPU solver threads (0: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
     /// Mesh tools.
     Mesh {
         /// Which tool.

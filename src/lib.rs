@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod body;
 pub mod cli;
+pub mod compare;
 pub mod mesh_cmd;
 pub mod progress;
 pub mod report;

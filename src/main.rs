@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use incise::cli::{Cli, Command, MeshCommand};
 use incise::run::{RunOptions, run_scene};
-use incise::{bench, mesh_cmd};
+use incise::{bench, compare, mesh_cmd};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -38,6 +38,12 @@ fn main() -> ExitCode {
             );
             println!("report: {}", o.report_path.display());
         }),
+        Command::Compare {
+            scene,
+            frames,
+            threads,
+            json,
+        } => compare::run(&scene, frames, threads, json),
         Command::Mesh { command } => match command {
             MeshCommand::Check { file, json } => mesh_cmd::check(&file, json),
             MeshCommand::Gen { kind, out } => mesh_cmd::generate(kind, &out),

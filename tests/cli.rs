@@ -295,3 +295,31 @@ fn device_gpu_matches_device_cpu() {
     assert_eq!(released[0], released[1]);
     assert!(released[0] > 0);
 }
+
+/// `incise compare` runs the tearing bar on both devices and finds them in agreement.
+#[test]
+fn compare_finds_cpu_and_gpu_in_agreement() {
+    if incise_sim::gpu::GpuContext::new().is_err() {
+        assert!(
+            std::env::var("INCISE_REQUIRE_GPU").map_or(true, |v| v != "1"),
+            "INCISE_REQUIRE_GPU=1 but no adapter"
+        );
+        eprintln!("skipping: no GPU adapter");
+        return;
+    }
+    let dir = temp_dir("compare");
+    let scene = dir.join("bar.ron");
+    std::fs::write(&scene, BAR).unwrap();
+    let o = incise(&[
+        "compare",
+        scene.to_str().unwrap(),
+        "--frames",
+        "30",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let c: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(c["agree"], true);
+    assert!(c["released_cpu"].as_u64().unwrap() > 0);
+    assert_eq!(c["released_mismatch"], 0);
+}
