@@ -79,6 +79,47 @@ pub enum Command {
         #[arg(long)]
         scaling: bool,
     },
+    /// Reproducible experiments that write the CSV tables and PNG figures of docs/experiments/.
+    Experiment {
+        /// Which experiment.
+        #[command(subcommand)]
+        command: ExperimentCommand,
+    },
+}
+
+/// Experiment subcommands.
+#[derive(Debug, Subcommand)]
+pub enum ExperimentCommand {
+    /// Three-element rheology (PHYSICS.md §3): creep vs closed form, press-and-release of a
+    /// block with every preset, hold-time sweep, force-dependent damper under gravity.
+    Rheology {
+        /// Output folder for the CSV tables, PNG figures and summary.txt.
+        #[arg(long)]
+        out: PathBuf,
+        /// Rheological preset file.
+        #[arg(long, default_value = "config/rheology.ron")]
+        presets: PathBuf,
+    },
+    /// Nakao 2003 plate (PHYSICS.md §2.6): the same straight cut at tension 0–6 %, adaptive
+    /// and non-adaptive; writes table.md/.csv, results.json and PNG figures.
+    NakaoPlate {
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Loop times of the mass-spring cutter on a chest-scale slab (18.5k nodes, 72k tets):
+    /// levels 4 and 6, the whole mesh, the refresh-rate manager and the blade advances.
+    NakaoBench {
+        /// Loops per case.
+        #[arg(long, default_value_t = 400)]
+        loops: usize,
+        /// Time budget per loop of the refresh-rate manager case, ms.
+        #[arg(long, default_value_t = 0.1)]
+        budget_ms: f64,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// Mesh subcommands.

@@ -3,9 +3,9 @@
 use std::process::ExitCode;
 
 use clap::Parser;
-use incise::cli::{Cli, Command, MeshCommand};
+use incise::cli::{Cli, Command, ExperimentCommand, MeshCommand};
 use incise::run::{RunOptions, run_scene};
-use incise::{bench, compare, mesh_cmd};
+use incise::{bench, compare, experiment, mesh_cmd};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -55,6 +55,25 @@ fn main() -> ExitCode {
             device,
             scaling,
         } => bench::run(case, frames, json, device, scaling),
+        Command::Experiment { command } => match command {
+            ExperimentCommand::Rheology { out, presets } => {
+                experiment::rheology::run(&experiment::rheology::RheologyOptions { out, presets })
+                    .map(|summary| print!("{summary}"))
+            }
+            ExperimentCommand::NakaoPlate { out } => {
+                experiment::nakao::run(&experiment::nakao::NakaoOptions { out })
+                    .map(|table| print!("{table}"))
+            }
+            ExperimentCommand::NakaoBench {
+                loops,
+                budget_ms,
+                json,
+            } => experiment::nakao_bench::run(&experiment::nakao_bench::NakaoBenchOptions {
+                loops,
+                budget_ms,
+                json,
+            }),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

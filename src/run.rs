@@ -45,6 +45,9 @@ pub struct RunOutcome {
 /// snapshots so far have been written.
 pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let scene = load_scene(&opts.scene)?;
+    if let crate::scene::ModelChoice::MassSpring(ms) = &scene.model {
+        return crate::run_mass_spring::run(&scene, ms, opts);
+    }
     let BuiltScene {
         solver,
         skin,

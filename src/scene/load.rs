@@ -90,6 +90,10 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             ));
         }
     }
+    if let super::ModelChoice::MassSpring(ms) = &scene.model {
+        ms.validate()
+            .map_err(|(field, msg)| value_err(&field, msg))?;
+    }
     for (i, g) in scene.grabs.iter().enumerate() {
         if !(g.speed.is_finite() && g.speed > 0.0) {
             return Err(value_err(

@@ -3,9 +3,12 @@
 
 mod build;
 mod load;
+mod model;
 
+pub use build::raw_mesh;
 pub use build::{BuiltScene, build_scene};
 pub use load::{SceneError, load_materials, load_scene, parse_scene};
+pub use model::{HoldSpec, MassSpringScene, ModelChoice, StrokeSpec};
 
 use glam::{UVec3, Vec3};
 use incise_sim::Material;
@@ -41,6 +44,9 @@ pub struct Scene {
     pub cutting: Option<Cutting>,
     /// Simulated duration, s.
     pub duration: f32,
+    /// Simulation model: `Xpbd` (default) or `MassSpring(...)` (PHYSICS.md §2).
+    #[serde(default)]
+    pub model: ModelChoice,
 }
 
 /// Where a tet mesh comes from.

@@ -1,0 +1,144 @@
+//! One localised simulation loop (PHYSICS.md §2.5): find the node nearest the tool, build
+//! the hierarchy to level d (or to the refresh-rate manager's node count), integrate the
+//! free nodes only, and feed the loop time back to the manager.
+
+use std::time::Instant;
+
+use glam::DVec3;
+
+use super::{MassSpringModel, NodeHierarchy, RefreshRateManager};
+
+/// A source of time, so that the loop can be tested with a scripted clock.
+pub trait Clock {
+    /// Seconds since an arbitrary origin, non-decreasing.
+    fn now(&self) -> f64;
+}
+
+/// The system's monotonic clock.
+#[derive(Debug, Clone, Copy)]
+pub struct SystemClock {
+    origin: Instant,
+}
+
+impl Default for SystemClock {
+    fn default() -> Self {
+        SystemClock {
+            origin: Instant::now(),
+        }
+    }
+}
+
+impl Clock for SystemClock {
+    fn now(&self) -> f64 {
+        self.origin.elapsed().as_secs_f64()
+    }
+}
+
+/// Settings of the local loop.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocalLoopParams {
+    /// Propagation depth d: nodes deeper than this level are frozen.
+    pub max_level: u32,
+    /// Time budget per loop for the refresh-rate manager, ms; `None`: fixed depth only.
+    pub budget_ms: Option<f64>,
+    /// Fewest free nodes the manager may choose.
+    pub min_nodes: usize,
+    /// Most free nodes the manager may choose.
+    pub max_nodes: usize,
+}
+
+impl Default for LocalLoopParams {
+    fn default() -> Self {
+        LocalLoopParams {
+            max_level: 4,
+            budget_ms: None,
+            min_nodes: 16,
+            max_nodes: usize::MAX,
+        }
+    }
+}
+
+/// What one loop did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoopStats {
+    /// The node nearest the tool.
+    pub root: u32,
+    /// Free (integrated) nodes.
+    pub free_nodes: usize,
+    /// Hierarchy levels built.
+    pub levels: usize,
+    /// Loop time (hierarchy + forces + integration), ms, by the loop's clock.
+    pub ms: f64,
+}
+
+/// The localised loop with its hierarchy, optional refresh-rate manager and clock.
+#[derive(Debug, Clone)]
+pub struct LocalLoop<C: Clock = SystemClock> {
+    params: LocalLoopParams,
+    hierarchy: NodeHierarchy,
+    manager: Option<RefreshRateManager>,
+    previous: Vec<u32>,
+    clock: C,
+}
+
+impl<C: Clock> LocalLoop<C> {
+    /// A loop with `params`, timed by `clock`.
+    pub fn new(params: LocalLoopParams, clock: C) -> Self {
+        let manager = params.budget_ms.map(|b| {
+            RefreshRateManager::new(
+                b,
+                params.min_nodes.max(64),
+                params.min_nodes,
+                params.max_nodes,
+            )
+        });
+        LocalLoop {
+            params,
+            hierarchy: NodeHierarchy::new(),
+            manager,
+            previous: Vec::new(),
+            clock,
+        }
+    }
+
+    /// The hierarchy of the last loop.
+    pub fn hierarchy(&self) -> &NodeHierarchy {
+        &self.hierarchy
+    }
+
+    /// The refresh-rate manager, when a budget is set.
+    pub fn manager(&self) -> Option<&RefreshRateManager> {
+        self.manager.as_ref()
+    }
+
+    /// One loop of `dt` with the tool at `tip`. Nodes that left the free set stop.
+    pub fn step(&mut self, model: &mut MassSpringModel, tip: DVec3, dt: f64) -> LoopStats {
+        let t0 = self.clock.now();
+        let root = self.hierarchy.nearest_node(model, tip).unwrap_or(0);
+        let (level, cap) = match &self.manager {
+            Some(m) => (u32::MAX, m.free_nodes()),
+            None => (self.params.max_level, self.params.max_nodes),
+        };
+        self.hierarchy.build(model, root, level, cap);
+        let left: Vec<u32> = self
+            .previous
+            .iter()
+            .copied()
+            .filter(|&v| !self.hierarchy.is_free(v))
+            .collect();
+        model.stop_nodes(&left);
+        model.step_nodes(dt, self.hierarchy.free_nodes());
+        let ms = (self.clock.now() - t0) * 1e3;
+        if let Some(m) = &mut self.manager {
+            m.update(ms);
+        }
+        self.previous.clear();
+        self.previous.extend_from_slice(self.hierarchy.free_nodes());
+        LoopStats {
+            root,
+            free_nodes: self.hierarchy.free_nodes().len(),
+            levels: self.hierarchy.levels(),
+            ms,
+        }
+    }
+}

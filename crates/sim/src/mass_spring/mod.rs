@@ -1,0 +1,28 @@
+//! The tension mass-spring model of Nakao et al. 2003 (PHYSICS.md §2): nodes at the tet
+//! vertices, a spring (and the node dampers) per tet edge, rest lengths shortened by the
+//! tension coefficient so the body starts in a strained equilibrium held by its fixed
+//! nodes. Localisation (§2.5): a breadth-first node hierarchy from the tool, frozen nodes
+//! beyond level d, and a refresh-rate manager. Cutting lives in [`crate::nakao_cut`].
+
+mod adjacency;
+mod axes;
+mod haptic;
+mod hierarchy;
+mod integrate;
+mod local_loop;
+mod model;
+mod params;
+mod refresh;
+mod tension;
+
+pub use adjacency::{ElementIndex, Rows};
+pub use axes::AxisMask;
+pub use haptic::{HapticConfig, HapticFrame, HapticLoop};
+pub use hierarchy::NodeHierarchy;
+pub use local_loop::{Clock, LocalLoop, LocalLoopParams, LoopStats, SystemClock};
+pub use model::{MassSpringModel, Spring};
+pub use params::{MassSpringError, MassSpringParams};
+pub use refresh::RefreshRateManager;
+pub use tension::Tension;
+
+pub(crate) use model::signed_volume;

@@ -1,0 +1,89 @@
+//! Localisation (PHYSICS.md §2.5): nodes deeper than level d do not move; the free set
+//! follows the tool; the refresh-rate manager bounds the free set.
+
+use glam::DVec3;
+use incise_sim::mass_spring::{Clock, LocalLoop, LocalLoopParams};
+use incise_sim::nakao_cut::{BladePose, CutParams, Cutter, plate_model};
+
+/// A scripted clock: every reading is 0.1 ms after the previous one.
+struct StepClock(std::cell::Cell<f64>);
+
+impl Clock for StepClock {
+    fn now(&self) -> f64 {
+        let t = self.0.get() + 1e-4;
+        self.0.set(t);
+        t
+    }
+}
+
+fn cut_plate() -> incise_sim::mass_spring::MassSpringModel {
+    let mut m = plate_model(0.04).unwrap();
+    let mut cutter = Cutter::new(CutParams::default());
+    let blade = |x: f64| BladePose {
+        heel: DVec3::new(x, 0.0011, -0.002),
+        tip: DVec3::new(x, 0.0011, 0.006),
+    };
+    cutter.begin(&m, blade(-0.02));
+    cutter.advance(&mut m, blade(0.02));
+    m
+}
+
+#[test]
+fn nodes_beyond_level_d_do_not_move() {
+    let mut m = cut_plate();
+    let before = m.positions().to_vec();
+    let params = LocalLoopParams {
+        max_level: 4,
+        ..LocalLoopParams::default()
+    };
+    let mut local = LocalLoop::new(params, StepClock(Default::default()));
+    let tip = DVec3::new(0.0, 0.0011, 0.004);
+    let dt = m.stable_dt();
+    let mut stats = None;
+    for _ in 0..400 {
+        stats = Some(local.step(&mut m, tip, dt));
+    }
+    let stats = stats.unwrap();
+    assert_eq!(stats.levels, 5, "levels 0..=4");
+    let h = local.hierarchy();
+    let (mut moved_free, mut frozen) = (0, 0);
+    for (i, (a, b)) in before.iter().zip(m.positions()).enumerate() {
+        if h.is_free(i as u32) {
+            moved_free += usize::from((*a - *b).length() > 1e-6);
+        } else {
+            frozen += 1;
+            assert_eq!(a, b, "frozen node {i} moved");
+        }
+    }
+    assert!(
+        moved_free > 10,
+        "the wound opens near the tool ({moved_free} nodes moved)"
+    );
+    assert!(frozen > m.node_count() / 2);
+    // The scripted clock reads 0.1 ms per loop.
+    assert!((stats.ms - 0.1).abs() < 1e-9);
+}
+
+#[test]
+fn free_set_follows_the_tool_and_the_manager_caps_it() {
+    let mut m = cut_plate();
+    let params = LocalLoopParams {
+        budget_ms: Some(0.05),
+        min_nodes: 20,
+        max_nodes: 300,
+        ..LocalLoopParams::default()
+    };
+    // 0.1 ms per loop against a 0.05 ms budget: the manager shrinks the set to its minimum.
+    let mut local = LocalLoop::new(params, StepClock(Default::default()));
+    let dt = m.stable_dt();
+    let a = local.step(&mut m, DVec3::new(-0.05, 0.03, 0.0), dt);
+    for _ in 0..30 {
+        local.step(&mut m, DVec3::new(0.05, -0.03, 0.0), dt);
+    }
+    let b = local.step(&mut m, DVec3::new(0.05, -0.03, 0.0), dt);
+    assert_ne!(a.root, b.root);
+    let p = m.positions()[b.root as usize];
+    assert!((p - DVec3::new(0.05, -0.03, 0.0)).length() < 0.006);
+    assert_eq!(b.free_nodes, 20);
+    assert_eq!(local.manager().unwrap().free_nodes(), 20);
+}

@@ -1,0 +1,5 @@
+//! Reproducible experiments that regenerate the figures and tables in `docs/experiments/`.
+
+pub mod nakao;
+pub mod nakao_bench;
+pub mod rheology;
