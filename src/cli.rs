@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use crate::body::DeviceChoice;
+use crate::screenshots::{ImageSize, OverlayArg};
 
 /// incise: mixed-reality surgical cutting trainer (headless runner, mesh tools, benchmarks).
 #[derive(Debug, Parser)]
@@ -38,6 +39,31 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
         /// Where the solver runs (auto: the GPU when an adapter exists, else the CPU).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+        /// Write DIR/frame_NNNNN.png every K frames, rendered offscreen (0: none).
+        #[arg(long, default_value_t = 0)]
+        screenshot_every: u64,
+        /// Size of those screenshots, WIDTHxHEIGHT.
+        #[arg(long, default_value = "960x540")]
+        screenshot_size: ImageSize,
+    },
+    /// Render one frame of a scene offscreen to a PNG (no window needed).
+    Render {
+        /// Scene file (RON).
+        scene: PathBuf,
+        /// Frames to simulate before rendering (0: the rest state).
+        #[arg(long, default_value_t = 0)]
+        frame: u64,
+        /// Output PNG.
+        out: PathBuf,
+        /// Image size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x720")]
+        size: ImageSize,
+        /// Overlays to draw (repeat or comma-separate).
+        #[arg(long, value_enum, value_delimiter = ',')]
+        overlay: Vec<OverlayArg>,
+        /// Where the solver runs (auto: on the render device's GPU).
         #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
         device: DeviceChoice,
     },

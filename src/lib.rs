@@ -10,3 +10,4 @@ pub mod progress;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod screenshots;

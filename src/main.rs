@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use incise::cli::{Cli, Command, MeshCommand};
 use incise::run::{RunOptions, run_scene};
-use incise::{bench, compare, mesh_cmd};
+use incise::{bench, compare, mesh_cmd, screenshots};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -18,6 +18,8 @@ fn main() -> ExitCode {
             threads,
             quiet,
             device,
+            screenshot_every,
+            screenshot_size,
         } => run_scene(&RunOptions {
             scene,
             frames,
@@ -26,6 +28,8 @@ fn main() -> ExitCode {
             threads,
             quiet,
             device,
+            screenshot_every,
+            screenshot_size,
         })
         .map(|o| {
             let last = o.report.frames.last();
@@ -38,6 +42,15 @@ fn main() -> ExitCode {
             );
             println!("report: {}", o.report_path.display());
         }),
+        Command::Render {
+            scene,
+            frame,
+            out,
+            size,
+            overlay,
+            device,
+        } => screenshots::render_frame(&scene, frame, &out, size, &overlay, device)
+            .map(|()| println!("wrote {}", out.display())),
         Command::Compare {
             scene,
             frames,
