@@ -11,9 +11,10 @@ use crate::screenshots::{ImageSize, OverlayArg};
 #[derive(Debug, Parser)]
 #[command(name = "incise", version, about)]
 pub struct Cli {
-    /// What to do.
+    /// What to do (none: the preview of the default scene, or a headless run of it
+    /// when there is no display).
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
 }
 
 /// Subcommands.
@@ -47,6 +48,23 @@ pub enum Command {
         /// Size of those screenshots, WIDTHxHEIGHT.
         #[arg(long, default_value = "960x540")]
         screenshot_size: ImageSize,
+    },
+    /// Open the desktop preview: the scene in a window with a control panel.
+    Preview {
+        /// Scene file (RON); default config/intestine_pull.ron.
+        scene: Option<PathBuf>,
+        /// Render this many frames, then exit.
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Save the window's last frame to this PNG on exit.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
+        /// Where the solver runs (auto: a hardware GPU if there is one, else the CPU).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+        /// Window size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x800")]
+        size: ImageSize,
     },
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {
@@ -87,8 +105,12 @@ pub enum Command {
         #[command(subcommand)]
         command: MeshCommand,
     },
-    /// Time the solver (10 substeps per frame) on the plate and the 34k-tet intestine.
+    /// Time the solver (10 substeps per frame) on the plate and the 34k-tet intestine, or
+    /// with `render` the offscreen renderer (1080p and Quest 3 stereo).
     Bench {
+        /// What to time.
+        #[arg(value_enum, default_value_t = BenchTarget::Solver)]
+        target: BenchTarget,
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
@@ -140,6 +162,15 @@ pub enum GenKind {
     Block,
     /// 20 cm × 2 cm × 2 cm beam, 40 × 4 × 4 cells.
     Beam,
+}
+
+/// What `incise bench` times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BenchTarget {
+    /// The XPBD solver.
+    Solver,
+    /// The renderer alone, offscreen.
+    Render,
 }
 
 /// Benchmark case selection.

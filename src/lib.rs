@@ -2,10 +2,12 @@
 //! The binary in `main.rs` is a thin CLI over these modules; `tests/` drives both.
 
 pub mod bench;
+pub mod bench_render;
 pub mod body;
 pub mod cli;
 pub mod compare;
 pub mod mesh_cmd;
+pub mod preview;
 pub mod progress;
 pub mod report;
 pub mod run;

@@ -188,7 +188,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
 }
 
 /// Write `snap_NNNNN.vtu` for frame `frame` and add it to the collection.
-fn snapshot(
+pub fn snapshot(
     out: &Path,
     solver: &incise_sim::Solver,
     frame: u64,

@@ -12,6 +12,8 @@ const STORAGE_BUFFERS: u32 = 8;
 /// An adapter's device and queue, opened for rendering and compute.
 #[derive(Debug, Clone)]
 pub struct RenderDevice {
+    /// The adapter (for surface capabilities).
+    pub adapter: wgpu::Adapter,
     /// The device.
     pub device: wgpu::Device,
     /// Its queue.
@@ -88,6 +90,7 @@ impl RenderDevice {
                 msg: e.to_string(),
             })?;
         Ok(RenderDevice {
+            adapter,
             device,
             queue,
             info,

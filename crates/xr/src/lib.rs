@@ -8,6 +8,7 @@
 //! wireframe, tool spheres, pinned nodes) and the tool mesh, with 4× MSAA into sRGB.
 
 pub mod camera;
+pub mod colour_map;
 pub mod compare;
 pub mod device;
 pub mod error;
