@@ -1,6 +1,6 @@
 // Shared structs and helpers of the XPBD compute kernels (PHYSICS.md §1). Every stage file
 // is compiled as common.wgsl + stage.wgsl; the Rust mirror of these structs is
-// crates/sim/src/gpu/layout.rs.
+// crates/sim/src/gpu/layout.rs. Node buffers hold displacements from the rest positions.
 
 struct Params {
     gravity: vec3<f32>,
@@ -44,7 +44,10 @@ fn dm_inv_of(r: TetRest) -> mat3x3<f32> {
     return mat3x3<f32>(r.c0.xyz, r.c1.xyz, r.c2.xyz);
 }
 
-// PHYSICS.md §1.2: F = Ds Dm^-1.
-fn deformation_gradient(x0: vec3<f32>, x1: vec3<f32>, x2: vec3<f32>, x3: vec3<f32>, dm_inv: mat3x3<f32>) -> mat3x3<f32> {
-    return mat3x3<f32>(x1 - x0, x2 - x0, x3 - x0) * dm_inv;
+const IDENTITY3: mat3x3<f32> = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
+
+// PHYSICS.md §1.2: F = Ds Dm^-1 = I + Du Dm^-1, from node displacements u = x - X (the
+// kernels' state; see Solver::u). CPU twin: deformation_gradient_from_displacement.
+fn deformation_gradient(u0: vec3<f32>, u1: vec3<f32>, u2: vec3<f32>, u3: vec3<f32>, dm_inv: mat3x3<f32>) -> mat3x3<f32> {
+    return IDENTITY3 + mat3x3<f32>(u1 - u0, u2 - u0, u3 - u0) * dm_inv;
 }

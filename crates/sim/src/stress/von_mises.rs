@@ -33,9 +33,12 @@ pub fn tet_stress(
     let rtf = r.transpose() * *f;
     let sym = (rtf + rtf.transpose()) * 0.5;
     let sigma_h = lambda_h / (h2 * rest_volume);
-    let sigma = (sym - Mat3::IDENTITY) * mu + Mat3::IDENTITY * sigma_h;
-    let mean = (sigma.x_axis.x + sigma.y_axis.y + sigma.z_axis.z) / 3.0;
-    let dev = sigma - Mat3::IDENTITY * mean;
+    // σ_T = μ(S − I) + σ_H I. The isotropic parts cancel in the deviator, so
+    // dev σ_T = μ dev S exactly; computing it that way avoids subtracting a large pressure
+    // from itself in f32 (PHYSICS.md §1.3: σ_vM = μ sqrt(3/2) ‖dev S‖_F).
+    let tr_s = sym.x_axis.x + sym.y_axis.y + sym.z_axis.z;
+    let mean = mu * (tr_s / 3.0 - 1.0) + sigma_h;
+    let dev = (sym - Mat3::IDENTITY * (tr_s / 3.0)) * mu;
     let norm2 =
         dev.x_axis.length_squared() + dev.y_axis.length_squared() + dev.z_axis.length_squared();
     TetStress {

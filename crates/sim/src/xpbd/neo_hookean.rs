@@ -41,6 +41,15 @@ pub fn deformation_gradient(x: &[Vec3; 4], dm_inv: &Mat3) -> Mat3 {
     shape_matrix(x[0], x[1], x[2], x[3]) * *dm_inv
 }
 
+/// Deformation gradient from node displacements `u = x − X`:
+/// `F = Ds Dm⁻¹ = (Dm + Du) Dm⁻¹ = I + Du Dm⁻¹`, exact in f32 for small `u` wherever the
+/// body sits (no subtraction of large coordinates).
+// PHYSICS.md §1.2, F = Ds Dm^-1.
+#[inline]
+pub fn deformation_gradient_from_displacement(u: &[Vec3; 4], dm_inv: &Mat3) -> Mat3 {
+    Mat3::IDENTITY + shape_matrix(u[0], u[1], u[2], u[3]) * *dm_inv
+}
+
 /// `∂det(F)/∂F = [f2×f3, f3×f1, f1×f2]` (columns).
 // PHYSICS.md §1.2, table row C_H.
 #[inline]
@@ -71,7 +80,8 @@ fn weighted_dot(w: &[f32; 4], a: &[Vec3; 4], b: &[Vec3; 4]) -> f32 {
     w[0] * a[0].dot(b[0]) + w[1] * a[1].dot(b[1]) + w[2] * a[2].dot(b[2]) + w[3] * a[3].dot(b[3])
 }
 
-/// Project both constraints of one tet in place; returns the hydrostatic multiplier `λ_H`
+/// Project both constraints of one tet in place (`x` holds the nodes' displacements from
+/// rest, see [`deformation_gradient_from_displacement`]); returns the hydrostatic multiplier `λ_H`
 /// of this substep (used for the hydrostatic stress, PHYSICS.md §1.3).
 #[inline]
 pub fn project_tet(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms, mode: TetProjection) -> f32 {
@@ -85,7 +95,7 @@ pub fn project_tet(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms, mode: TetProje
 /// `[S_HH+α̃_H, S_HD; S_HD, S_DD+α̃_D] Δλ = −C`, `x_i += w_i (∇_i C_H Δλ_H + ∇_i C_D Δλ_D)`.
 // PHYSICS.md §1.2, XPBD update (block form of Δλ = (−C − α̃λ)/(Σ w|∇C|² + α̃) with λ = 0).
 fn project_coupled(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
-    let f = deformation_gradient(x, &t.dm_inv);
+    let f = deformation_gradient_from_displacement(x, &t.dm_inv);
     let c_h = f.determinant() - t.gamma;
     let g_h = vertex_gradients(det_gradient(&f), &t.dm_inv);
     let norm =
@@ -117,10 +127,10 @@ fn project_coupled(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
 
 /// H then D, each a scalar XPBD step (the form written in PHYSICS.md §1.2).
 fn project_sequential(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
-    let f = deformation_gradient(x, &t.dm_inv);
+    let f = deformation_gradient_from_displacement(x, &t.dm_inv);
     let g_h = vertex_gradients(det_gradient(&f), &t.dm_inv);
     let dl_h = apply_scalar(x, w, &g_h, f.determinant() - t.gamma, t.alpha_h);
-    let f = deformation_gradient(x, &t.dm_inv);
+    let f = deformation_gradient_from_displacement(x, &t.dm_inv);
     let norm =
         (f.x_axis.length_squared() + f.y_axis.length_squared() + f.z_axis.length_squared()).sqrt();
     if norm >= 1e-12 {
@@ -181,12 +191,11 @@ mod tests {
 
     #[test]
     fn coupled_projection_keeps_the_rest_state_of_a_tet() {
-        // μ = λ: α̃_H = α̃_D, γ = 2.
-        let rest = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
-        let mut x = rest;
-        project_tet(&mut x, &[1.0; 4], &terms(0.5, 2.0), TetProjection::Coupled);
-        for (a, b) in x.iter().zip(&rest) {
-            assert!((*a - *b).length() < 1e-6, "{a} moved from {b}");
+        // μ = λ: α̃_H = α̃_D, γ = 2. Displacements start at zero (the rest state).
+        let mut u = [Vec3::ZERO; 4];
+        project_tet(&mut u, &[1.0; 4], &terms(0.5, 2.0), TetProjection::Coupled);
+        for a in &u {
+            assert!(a.length() < 1e-6, "a node moved by {a}");
         }
     }
 
@@ -208,8 +217,9 @@ mod tests {
 
     #[test]
     fn stiff_projection_restores_volume_of_a_squashed_tet() {
-        // γ = 1 (λ → ∞ limit), tiny compliance: one step brings det F near 1.
-        let mut x = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z * 0.5];
+        // γ = 1 (λ → ∞ limit), tiny compliance: a few steps bring det F near 1. Rest tet
+        // (0, X, Y, Z) with Dm = I, squashed to half height: u_3 = −Z/2.
+        let mut x = [Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::Z * -0.5];
         let t = TetTerms {
             dm_inv: Mat3::IDENTITY,
             alpha_h: 1e-6,
@@ -219,7 +229,7 @@ mod tests {
         for _ in 0..20 {
             project_tet(&mut x, &[1.0; 4], &t, TetProjection::Coupled);
         }
-        let det = deformation_gradient(&x, &Mat3::IDENTITY).determinant();
+        let det = deformation_gradient_from_displacement(&x, &Mat3::IDENTITY).determinant();
         assert!((det - 1.0).abs() < 1e-3, "det {det}");
     }
 }

@@ -4,6 +4,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::TetProjection;
+use crate::material::HydrostaticStiffness;
 
 /// Settings of the XPBD small-steps solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -19,6 +20,9 @@ pub struct SolverParams {
     pub damping: f32,
     /// How a tet's two constraints are projected.
     pub projection: TetProjection,
+    /// Stiffness of the hydrostatic constraint: `Lambda` (PHYSICS.md, default) or
+    /// `LambdaPlusMu` (small-strain response matches E and ν exactly).
+    pub hydrostatic: HydrostaticStiffness,
     /// Worker threads for the coloured projection: 0 = all cores, 1 = serial.
     pub threads: usize,
     /// von Mises stress above which a tet is released, Pa; `None` disables cutting.
@@ -35,6 +39,7 @@ impl Default for SolverParams {
             gravity: Vec3::new(0.0, 0.0, -9.81),
             damping: 1.0,
             projection: TetProjection::Coupled,
+            hydrostatic: HydrostaticStiffness::Lambda,
             threads: 0,
             release_threshold: None,
             max_inverted_frames: 30,

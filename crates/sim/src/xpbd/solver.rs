@@ -8,7 +8,7 @@ use glam::{Mat3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::coloring::greedy_tet_colors;
-use super::neo_hookean::{TetTerms, deformation_gradient, project_tet};
+use super::neo_hookean::{TetTerms, deformation_gradient_from_displacement, project_tet};
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
 use super::{FrameStats, SolverError, SolverParams};
@@ -47,8 +47,13 @@ pub struct Solver {
     pub(crate) mesh: TetMesh,
     pub(crate) lame: Lame,
     pub(crate) params: SolverParams,
+    /// World positions `X + u`, refreshed at the end of every frame.
     pub(crate) x: Vec<Vec3>,
-    pub(crate) x_prev: Vec<Vec3>,
+    /// Displacements from rest `u = x − X`: the solver's state. Solving for u keeps f32
+    /// increments of h²g (tens of nm at hundreds of substeps) representable wherever the
+    /// body sits, and `F = I + Du Dm⁻¹` never subtracts large coordinates.
+    pub(crate) u: Vec<Vec3>,
+    pub(crate) u_prev: Vec<Vec3>,
     pub(crate) v: Vec<Vec3>,
     pub(crate) mass: Vec<f32>,
     pub(crate) inv_mass: Vec<f32>,
@@ -129,8 +134,9 @@ impl Solver {
         let t = mesh.tet_count();
         let mut solver = Solver {
             x: mesh.rest_positions.clone(),
-            x_prev: mesh.rest_positions.clone(),
-            start: mesh.rest_positions.clone(),
+            u: vec![Vec3::ZERO; n],
+            u_prev: vec![Vec3::ZERO; n],
+            start: vec![Vec3::ZERO; n],
             v: vec![Vec3::ZERO; n],
             mass,
             inv_mass,
@@ -170,10 +176,11 @@ impl Solver {
         let v = self.mesh.rest_volume[t];
         TetTerms {
             dm_inv: self.mesh.dm_inv[t],
-            // PHYSICS.md §1.2: α_H = 1/(λV), α_D = 1/(μV), α̃ = α/h².
-            alpha_h: 1.0 / (self.lame.lambda * v * h * h),
+            // PHYSICS.md §1.2: α_H = 1/(λ_H V), α_D = 1/(μV), α̃ = α/h² (λ_H: see
+            // `Lame::hydrostatic`).
+            alpha_h: 1.0 / (self.lame.hydrostatic(self.params.hydrostatic) * v * h * h),
             alpha_d: 1.0 / (self.lame.mu * v * h * h),
-            gamma: 1.0 + self.lame.mu / self.lame.lambda,
+            gamma: self.lame.gamma(self.params.hydrostatic),
         }
     }
 
@@ -199,10 +206,13 @@ impl Solver {
 
     /// Replace all node positions (e.g. to start from a deformed state); velocities are zeroed.
     pub fn set_positions(&mut self, x: &[Vec3]) {
-        self.x.copy_from_slice(x);
-        self.x_prev.copy_from_slice(x);
-        self.start.copy_from_slice(x);
+        for (i, p) in x.iter().enumerate() {
+            self.u[i] = *p - self.mesh.rest_positions[i];
+        }
+        self.u_prev.copy_from_slice(&self.u);
+        self.start.copy_from_slice(&self.u);
         self.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
+        self.sync_positions();
     }
 
     /// Current node velocities, m/s.
@@ -266,7 +276,7 @@ impl Solver {
         for &i in &grab.nodes {
             self.kind[i as usize] = NodeKind::Grabbed(id);
             self.inv_mass[i as usize] = 0.0;
-            self.start[i as usize] = self.x[i as usize];
+            self.start[i as usize] = self.u[i as usize];
         }
         self.grabs.push(grab);
     }
@@ -290,7 +300,7 @@ impl Solver {
     /// On a NaN/Inf position or a tet inverted for longer than `max_inverted_frames`, the
     /// frame is rolled back and an error names the frame and the tet.
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
-        let saved = (self.x.clone(), self.v.clone());
+        let saved = (self.u.clone(), self.v.clone());
         let t0 = Instant::now();
         match self.pool.take() {
             Some(pool) => {
@@ -300,6 +310,7 @@ impl Solver {
             None => self.run_substeps(false),
         }
         self.time += self.params.frame_dt as f64;
+        self.sync_positions();
         let t1 = Instant::now();
         let checked = match self.pool.take() {
             Some(pool) => {
@@ -310,9 +321,10 @@ impl Solver {
             None => self.update_stress_and_check(false),
         };
         if let Err(e) = checked {
-            self.x = saved.0;
-            self.x_prev.clone_from(&self.x);
+            self.u = saved.0;
+            self.u_prev.clone_from(&self.u);
             self.v = saved.1;
+            self.sync_positions();
             self.time -= self.params.frame_dt as f64;
             return Err(e);
         }
@@ -336,20 +348,20 @@ impl Solver {
         }
     }
 
-    /// `v += h g; x_prev = x; x += h v` for free nodes; kinematic nodes jump to their
+    /// `v += h g; u_prev = u; u += h v` for free nodes; kinematic nodes jump to their
     /// target at the end of the substep.
     // PHYSICS.md §1.2, small-steps loop, prediction.
     fn predict(&mut self, h: f32, t: f64) {
         let offsets: Vec<Vec3> = self.grabs.iter().map(|g| g.offset_at(t)).collect();
         let g = self.params.gravity;
-        for i in 0..self.x.len() {
-            self.x_prev[i] = self.x[i];
+        for i in 0..self.u.len() {
+            self.u_prev[i] = self.u[i];
             match self.kind[i] {
                 NodeKind::Free => {
                     self.v[i] += h * g;
-                    self.x[i] += h * self.v[i];
+                    self.u[i] += h * self.v[i];
                 }
-                NodeKind::Grabbed(k) => self.x[i] = self.start[i] + offsets[k as usize],
+                NodeKind::Grabbed(k) => self.u[i] = self.start[i] + offsets[k as usize],
                 NodeKind::Pinned | NodeKind::Retired => {}
             }
         }
@@ -359,7 +371,7 @@ impl Solver {
     fn project_color(&mut self, c: usize, parallel: bool) {
         let range = self.color_ranges[c].clone();
         let mode = self.params.projection;
-        let nodes = SharedNodes::new(&mut self.x);
+        let nodes = SharedNodes::new(&mut self.u);
         let inv_mass = &self.inv_mass;
         let work = |slot: &TetSlot, lambda: &mut f32| {
             if !slot.live {
@@ -392,15 +404,15 @@ impl Solver {
         }
     }
 
-    /// `v = (x − x_prev)/h`, then damping.
+    /// `v = (u − u_prev)/h` (= (x − x_prev)/h), then damping.
     // PHYSICS.md §1.2, small-steps loop, velocity update.
     fn update_velocities(&mut self, h: f32) {
         let keep = (1.0 - self.params.damping * h).max(0.0);
         let inv_h = 1.0 / h;
-        for i in 0..self.x.len() {
+        for i in 0..self.u.len() {
             self.v[i] = match self.kind[i] {
-                NodeKind::Free => (self.x[i] - self.x_prev[i]) * inv_h * keep,
-                NodeKind::Grabbed(_) => (self.x[i] - self.x_prev[i]) * inv_h,
+                NodeKind::Free => (self.u[i] - self.u_prev[i]) * inv_h * keep,
+                NodeKind::Grabbed(_) => (self.u[i] - self.u_prev[i]) * inv_h,
                 NodeKind::Pinned | NodeKind::Retired => Vec3::ZERO,
             };
         }
@@ -413,9 +425,21 @@ impl Solver {
         self.check_inversion()
     }
 
-    /// NaN/Inf guard on node positions.
+    /// World positions `x = X + u` from the displacements.
+    pub(crate) fn sync_positions(&mut self) {
+        for ((x, r), u) in self
+            .x
+            .iter_mut()
+            .zip(&self.mesh.rest_positions)
+            .zip(&self.u)
+        {
+            *x = *r + *u;
+        }
+    }
+
+    /// NaN/Inf guard on node displacements.
     pub(crate) fn check_finite(&self) -> Result<(), SolverError> {
-        if let Some(node) = self.x.iter().position(|p| !p.is_finite()) {
+        if let Some(node) = self.u.iter().position(|p| !p.is_finite()) {
             let tet = self.mesh.tets_of_node(node).first().copied().unwrap_or(0) as usize;
             return Err(SolverError::NonFinite {
                 frame: self.frame,
@@ -430,7 +454,7 @@ impl Solver {
     fn compute_stress(&mut self, parallel: bool) {
         let h = self.params.substep();
         let mu = self.lame.mu;
-        let (mesh, x, cut) = (&self.mesh, &self.x, &self.cut);
+        let (mesh, u, cut) = (&self.mesh, &self.u, &self.cut);
         let (lambda_h, slot_of_tet) = (&self.lambda_h, &self.slot_of_tet);
         let compute = |t: usize, out: (&mut f32, &mut f32, &mut Quat)| {
             if !cut.is_live(t) {
@@ -438,8 +462,8 @@ impl Solver {
                 return;
             }
             let idx = mesh.tets[t];
-            let p = idx.map(|i| x[i as usize]);
-            let f: Mat3 = deformation_gradient(&p, &mesh.dm_inv[t]);
+            let d = idx.map(|i| u[i as usize]);
+            let f: Mat3 = deformation_gradient_from_displacement(&d, &mesh.dm_inv[t]);
             let lam = lambda_h[slot_of_tet[t] as usize];
             let s = tet_stress(&f, mu, lam, h * h, mesh.rest_volume[t], *out.2);
             *out.0 = s.von_mises;
