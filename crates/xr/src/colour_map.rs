@@ -23,12 +23,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn runs_from_dark_blue_through_green_to_dark_red() {
+    fn runs_from_near_black_through_green_to_dark_red() {
         let lo = turbo(0.0);
-        assert!(
-            lo[2] > lo[0] && lo[2] > lo[1] && lo.iter().all(|&c| c < 0.3),
-            "{lo:?}"
-        );
+        assert!(lo[2] > lo[1] && lo.iter().all(|&c| c < 0.2), "{lo:?}");
+        let blue = turbo(0.15);
+        assert!(blue[2] > 0.8 && blue[2] > blue[0] && blue[2] > blue[1], "{blue:?}");
         let mid = turbo(0.5);
         assert!(mid[1] > 0.8, "{mid:?}");
         let hi = turbo(1.0);
