@@ -27,7 +27,10 @@ mod tests {
         let lo = turbo(0.0);
         assert!(lo[2] > lo[1] && lo.iter().all(|&c| c < 0.2), "{lo:?}");
         let blue = turbo(0.15);
-        assert!(blue[2] > 0.8 && blue[2] > blue[0] && blue[2] > blue[1], "{blue:?}");
+        assert!(
+            blue[2] > 0.8 && blue[2] > blue[0] && blue[2] > blue[1],
+            "{blue:?}"
+        );
         let mid = turbo(0.5);
         assert!(mid[1] > 0.8, "{mid:?}");
         let hi = turbo(1.0);
