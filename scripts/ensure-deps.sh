@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what building and testing incise needs on a fresh Debian/Ubuntu machine, only if
-# missing: a C toolchain, curl, the Vulkan loader and Mesa's drivers (apt), and Rust with
-# rustfmt and clippy (rustup).
+# missing: a C toolchain, curl, the Vulkan loader and Mesa's drivers, Xvfb and the X11
+# libraries the preview window loads (apt), and Rust with rustfmt and clippy (rustup).
 set -euo pipefail
 
 apt_install() {
@@ -18,6 +18,14 @@ command -v pkg-config >/dev/null 2>&1 || missing+=(pkg-config)
 # Vulkan loader + Mesa drivers: the GPU solver runs on any adapter, in CI on lavapipe.
 ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1 || missing+=(mesa-vulkan-drivers)
 ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' || missing+=(libvulkan1)
+# X virtual framebuffer for the preview-window test (xvfb-run needs xauth); the X11 client
+# libraries winit loads at run time.
+command -v xvfb-run >/dev/null 2>&1 || missing+=(xvfb)
+command -v xauth >/dev/null 2>&1 || missing+=(xauth)
+ldconfig -p 2>/dev/null | grep -q 'libxkbcommon-x11.so.0' || missing+=(libxkbcommon-x11-0)
+ldconfig -p 2>/dev/null | grep -q 'libXcursor.so.1' || missing+=(libxcursor1)
+ldconfig -p 2>/dev/null | grep -q 'libXi.so.6' || missing+=(libxi6)
+ldconfig -p 2>/dev/null | grep -q 'libXrandr.so.2' || missing+=(libxrandr2)
 if [ ${#missing[@]} -gt 0 ]; then
     echo "installing system packages: ${missing[*]}"
     apt_install "${missing[@]}"

@@ -262,7 +262,7 @@ fn peak_mib() -> f64 {
 }
 
 /// CPU model name and logical core count.
-fn machine() -> String {
+pub fn machine() -> String {
     let model = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {

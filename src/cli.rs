@@ -5,14 +5,16 @@ use std::path::PathBuf;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use crate::body::DeviceChoice;
+use crate::screenshots::{ImageSize, OverlayArg};
 
 /// incise: mixed-reality surgical cutting trainer (headless runner, mesh tools, benchmarks).
 #[derive(Debug, Parser)]
 #[command(name = "incise", version, about)]
 pub struct Cli {
-    /// What to do.
+    /// What to do (none: the preview of the default scene, or a headless run of it
+    /// when there is no display).
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
 }
 
 /// Subcommands.
@@ -40,6 +42,48 @@ pub enum Command {
         /// Where the solver runs (auto: the GPU when an adapter exists, else the CPU).
         #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
         device: DeviceChoice,
+        /// Write DIR/frame_NNNNN.png every K frames, rendered offscreen (0: none).
+        #[arg(long, default_value_t = 0)]
+        screenshot_every: u64,
+        /// Size of those screenshots, WIDTHxHEIGHT.
+        #[arg(long, default_value = "960x540")]
+        screenshot_size: ImageSize,
+    },
+    /// Open the desktop preview: the scene in a window with a control panel.
+    Preview {
+        /// Scene file (RON); default config/intestine_pull.ron.
+        scene: Option<PathBuf>,
+        /// Render this many frames, then exit.
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Save the window's last frame to this PNG on exit.
+        #[arg(long)]
+        screenshot: Option<PathBuf>,
+        /// Where the solver runs (auto: a hardware GPU if there is one, else the CPU).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+        /// Window size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x800")]
+        size: ImageSize,
+    },
+    /// Render one frame of a scene offscreen to a PNG (no window needed).
+    Render {
+        /// Scene file (RON).
+        scene: PathBuf,
+        /// Frames to simulate before rendering (0: the rest state).
+        #[arg(long, default_value_t = 0)]
+        frame: u64,
+        /// Output PNG.
+        out: PathBuf,
+        /// Image size, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x720")]
+        size: ImageSize,
+        /// Overlays to draw (repeat or comma-separate).
+        #[arg(long, value_enum, value_delimiter = ',')]
+        overlay: Vec<OverlayArg>,
+        /// Where the solver runs (auto: on the render device's GPU).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
     },
     /// Run a scene on the CPU and the GPU side by side; exit 1 if they disagree.
     Compare {
@@ -61,8 +105,12 @@ pub enum Command {
         #[command(subcommand)]
         command: MeshCommand,
     },
-    /// Time the solver (10 substeps per frame) on the plate and the 34k-tet intestine.
+    /// Time the solver (10 substeps per frame) on the plate and the 34k-tet intestine, or
+    /// with `render` the offscreen renderer (1080p and Quest 3 stereo).
     Bench {
+        /// What to time.
+        #[arg(value_enum, default_value_t = BenchTarget::Solver)]
+        target: BenchTarget,
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
@@ -155,6 +203,15 @@ pub enum GenKind {
     Block,
     /// 20 cm × 2 cm × 2 cm beam, 40 × 4 × 4 cells.
     Beam,
+}
+
+/// What `incise bench` times.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BenchTarget {
+    /// The XPBD solver.
+    Solver,
+    /// The renderer alone, offscreen.
+    Render,
 }
 
 /// Benchmark case selection.

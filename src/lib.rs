@@ -2,14 +2,17 @@
 //! The binary in `main.rs` is a thin CLI over these modules; `tests/` drives both.
 
 pub mod bench;
+pub mod bench_render;
 pub mod body;
 pub mod cli;
 pub mod compare;
 pub mod experiment;
 pub mod mesh_cmd;
 pub mod plot;
+pub mod preview;
 pub mod progress;
 pub mod report;
 pub mod run;
 pub mod run_mass_spring;
 pub mod scene;
+pub mod screenshots;

@@ -3,13 +3,49 @@
 use std::process::ExitCode;
 
 use clap::Parser;
-use incise::cli::{Cli, Command, ExperimentCommand, MeshCommand};
+use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
+use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
-use incise::{bench, compare, experiment, mesh_cmd};
+use incise::screenshots::ImageSize;
+use incise::{bench, bench_render, compare, experiment, mesh_cmd, screenshots};
+
+/// The scene opened when none is named.
+const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
+
+/// No subcommand: the preview of the default scene when a window can open, else the
+/// headless run of it (as scripts/run.sh), saying so.
+fn default_command() -> Command {
+    match preview::display::missing_display() {
+        None => Command::Preview {
+            scene: None,
+            frames: None,
+            screenshot: None,
+            device: incise::body::DeviceChoice::Auto,
+            size: ImageSize(1280, 800),
+        },
+        Some(why) => {
+            eprintln!(
+                "{why}: running {DEFAULT_SCENE} headless (`incise --help` lists the commands)"
+            );
+            Command::Run {
+                scene: DEFAULT_SCENE.into(),
+                frames: None,
+                out: "out/intestine_pull".into(),
+                vtu_every: 10,
+                threads: None,
+                quiet: false,
+                device: incise::body::DeviceChoice::Auto,
+                screenshot_every: 0,
+                screenshot_size: ImageSize(960, 540),
+            }
+        }
+    }
+}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    let command = cli.command.unwrap_or_else(default_command);
+    let result = match command {
         Command::Run {
             scene,
             frames,
@@ -18,6 +54,8 @@ fn main() -> ExitCode {
             threads,
             quiet,
             device,
+            screenshot_every,
+            screenshot_size,
         } => run_scene(&RunOptions {
             scene,
             frames,
@@ -26,6 +64,8 @@ fn main() -> ExitCode {
             threads,
             quiet,
             device,
+            screenshot_every,
+            screenshot_size,
         })
         .map(|o| {
             let last = o.report.frames.last();
@@ -38,6 +78,28 @@ fn main() -> ExitCode {
             );
             println!("report: {}", o.report_path.display());
         }),
+        Command::Preview {
+            scene,
+            frames,
+            screenshot,
+            device,
+            size,
+        } => preview::run(PreviewOptions {
+            scene: scene.unwrap_or_else(|| DEFAULT_SCENE.into()),
+            frames,
+            screenshot,
+            device,
+            size,
+        }),
+        Command::Render {
+            scene,
+            frame,
+            out,
+            size,
+            overlay,
+            device,
+        } => screenshots::render_frame(&scene, frame, &out, size, &overlay, device)
+            .map(|()| println!("wrote {}", out.display())),
         Command::Compare {
             scene,
             frames,
@@ -49,6 +111,13 @@ fn main() -> ExitCode {
             MeshCommand::Gen { kind, out } => mesh_cmd::generate(kind, &out),
         },
         Command::Bench {
+            target: BenchTarget::Render,
+            json,
+            frames,
+            ..
+        } => bench_render::run(frames, json),
+        Command::Bench {
+            target: BenchTarget::Solver,
             json,
             frames,
             case,

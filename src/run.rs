@@ -12,6 +12,7 @@ use crate::body::{Body, DeviceChoice};
 use crate::progress::Progress;
 use crate::report::{FrameRecord, MaterialInfo, MeshInfo, Report};
 use crate::scene::{BuiltScene, build_scene, load_scene};
+use crate::screenshots::{ImageSize, Screenshots};
 
 /// Options of `incise run`.
 #[derive(Debug, Clone)]
@@ -30,6 +31,10 @@ pub struct RunOptions {
     pub quiet: bool,
     /// Where the solver runs.
     pub device: DeviceChoice,
+    /// Write an offscreen `frame_NNNNN.png` every K frames (0 = none).
+    pub screenshot_every: u64,
+    /// Size of those screenshots.
+    pub screenshot_size: ImageSize,
 }
 
 /// What a finished run produced.
@@ -57,6 +62,16 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         pinned_nodes,
         grabbed_nodes,
     } = build_scene(&scene, &opts.scene, opts.threads)?;
+    let mut shots = match opts.screenshot_every {
+        0 => None,
+        _ => Some(Screenshots::new(
+            None,
+            &solver,
+            &skin,
+            opts.screenshot_size,
+            Default::default(),
+        )?),
+    };
     let quiet = opts.quiet;
     let mut body = Body::place(solver, opts.device, |m| {
         if !quiet {
@@ -108,6 +123,9 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     if opts.vtu_every > 0 {
         snapshot(&opts.out, body.solver(), 0, &mut pvd)?;
     }
+    if let Some(s) = &mut shots {
+        s.save(&body, &opts.out.join("frame_00000.png"))?;
+    }
     let progress = (!opts.quiet).then(|| Progress::new(frames, 60));
     let mut failure = None;
     for f in 0..frames {
@@ -136,6 +154,12 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         }
         if opts.vtu_every > 0 && (f + 1) % opts.vtu_every == 0 {
             snapshot(&opts.out, body.solver(), f + 1, &mut pvd)?;
+        }
+        if let Some(s) = shots
+            .as_mut()
+            .filter(|_| (f + 1) % opts.screenshot_every == 0)
+        {
+            s.save(&body, &opts.out.join(format!("frame_{:05}.png", f + 1)))?;
         }
     }
     if let Some(p) = &progress {
@@ -167,7 +191,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
 }
 
 /// Write `snap_NNNNN.vtu` for frame `frame` and add it to the collection.
-fn snapshot(
+pub fn snapshot(
     out: &Path,
     solver: &incise_sim::Solver,
     frame: u64,

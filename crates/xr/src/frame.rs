@@ -1,0 +1,121 @@
+//! What the renderer is given each frame: the body's state and the display settings.
+
+use glam::{Mat4, Vec3};
+use incise_sim::Solver;
+use incise_sim::cutting::CutState;
+use incise_sim::xpbd::NodeKind;
+
+/// The simulated body as of the last frame.
+#[derive(Clone, Copy)]
+pub struct BodyState<'a> {
+    /// Node positions on the host (the CPU solver's, or the GPU solver's mirror), m.
+    pub positions: &'a [Vec3],
+    /// The same positions already on the render device (`vec4<f32>` per node, as the GPU
+    /// solver keeps them): copied on the device instead of uploading `positions`.
+    pub device_positions: Option<&'a wgpu::Buffer>,
+    /// Live tets, visible faces and their changes.
+    pub cut: &'a CutState,
+    /// von Mises stress per tet (mesh order), Pa.
+    pub von_mises: &'a [f32],
+    /// Pinned nodes (drawn by the pinned-nodes overlay).
+    pub pinned: &'a [u32],
+}
+
+impl<'a> BodyState<'a> {
+    /// The state of `solver` (host positions); `pinned` lists its pinned nodes, see
+    /// [`pinned_nodes`].
+    pub fn of_solver(solver: &'a Solver, pinned: &'a [u32]) -> Self {
+        BodyState {
+            positions: solver.positions(),
+            device_positions: None,
+            cut: solver.cut(),
+            von_mises: solver.von_mises(),
+            pinned,
+        }
+    }
+}
+
+/// The pinned nodes of `solver`.
+pub fn pinned_nodes(solver: &Solver) -> Vec<u32> {
+    solver
+        .node_kinds()
+        .iter()
+        .enumerate()
+        .filter(|(_, k)| **k == NodeKind::Pinned)
+        .map(|(i, _)| i as u32)
+        .collect()
+}
+
+/// Which overlays are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Overlays {
+    /// von Mises heat map on the tet surface (replaces the skin).
+    pub stress: bool,
+    /// Edges of the live tets.
+    pub wireframe: bool,
+    /// The tool's contact spheres.
+    pub tool_spheres: bool,
+    /// Pinned nodes.
+    pub pinned: bool,
+}
+
+/// How surfaces are coloured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShadingMode {
+    /// Tissue shading (the normal picture).
+    #[default]
+    Lit,
+    /// Flat colours per material (skin, skin back, cut surface, stress, tool, markers,
+    /// lines; see [`MATERIAL_IDS`]), for tests and picking.
+    MaterialIds,
+}
+
+/// The flat colours of [`ShadingMode::MaterialIds`], by material name.
+pub const MATERIAL_IDS: [(&str, [u8; 3]); 7] = [
+    ("skin", [0, 255, 0]),
+    ("skin_back", [0, 0, 255]),
+    ("cut", [255, 0, 0]),
+    ("stress", [255, 255, 0]),
+    ("tool", [255, 0, 255]),
+    ("marker", [0, 255, 255]),
+    ("line", [255, 255, 255]),
+];
+
+/// The scalpel (or stand-in) as drawn.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ToolState {
+    /// Tool mesh placement (rigid: rotation and translation); `None` hides the mesh.
+    pub transform: Option<Mat4>,
+    /// Contact spheres (centre, radius), m: drawn by the tool-spheres overlay.
+    pub spheres: Vec<(Vec3, f32)>,
+}
+
+/// Display settings of one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    /// Overlays drawn.
+    pub overlays: Overlays,
+    /// Shading mode.
+    pub shading: ShadingMode,
+    /// Stress at the top of the heat-map colour scale, Pa (the cut threshold, usually).
+    pub stress_max: f32,
+    /// The tool.
+    pub tool: ToolState,
+    /// Background colour (linear RGB).
+    pub background: [f64; 3],
+    /// Exposure applied before tone mapping.
+    pub exposure: f32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            overlays: Overlays::default(),
+            shading: ShadingMode::Lit,
+            stress_max: 1e4,
+            tool: ToolState::default(),
+            background: [0.020, 0.024, 0.032],
+            exposure: 1.0,
+        }
+    }
+}

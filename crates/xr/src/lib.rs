@@ -1,0 +1,32 @@
+//! incise-xr: the renderer of incise.
+//!
+//! One wgpu renderer for the desktop preview, offscreen screenshots and the XR mode: it
+//! takes a device and queue, one view per eye and target textures, and knows nothing of
+//! windows, headsets or the command line. Per frame it deforms the skin on the GPU from
+//! its tet embedding, hides skin triangles of released tets, draws the cut surface in a
+//! wet-tissue material, and adds the switchable overlays (von Mises heat map, tet
+//! wireframe, tool spheres, pinned nodes) and the tool mesh, with 4× MSAA into sRGB.
+
+pub mod camera;
+pub mod colour_map;
+pub mod compare;
+pub mod device;
+pub mod error;
+pub mod frame;
+mod gpu_skin;
+pub mod image_io;
+pub mod offscreen;
+mod pipelines;
+pub mod renderer;
+mod scene_buffers;
+pub mod shaders;
+mod targets;
+pub mod tool_mesh;
+
+pub use camera::{Camera, View};
+pub use device::RenderDevice;
+pub use error::RenderError;
+pub use frame::{BodyState, Overlays, RenderSettings, ShadingMode};
+pub use image_io::RgbaImage;
+pub use offscreen::OffscreenRenderer;
+pub use renderer::Renderer;

@@ -1,0 +1,56 @@
+//! The WGSL sources of the renderer (`shaders/`): render shaders get
+//! `render_common.wgsl` (globals and tissue shading) prepended; compute shaders stand alone.
+
+const COMMON: &str = include_str!("../../../shaders/render_common.wgsl");
+
+/// Render shaders (each `shaders/<name>.wgsl`, with the common part prepended).
+pub const RENDER_SHADERS: [&str; 5] = ["skin", "tet_faces", "wireframe", "markers", "tool"];
+
+/// Compute shaders of the skin deformation (each `shaders/<name>.wgsl`).
+pub const COMPUTE_SHADERS: [&str; 2] = ["skin_deform", "skin_normals"];
+
+/// Full WGSL source of a renderer shader, or `None` if unknown.
+pub fn source(name: &str) -> Option<String> {
+    let render = |body: &str| format!("{COMMON}\n{body}");
+    Some(match name {
+        "skin" => render(include_str!("../../../shaders/skin.wgsl")),
+        "tet_faces" => render(include_str!("../../../shaders/tet_faces.wgsl")),
+        "wireframe" => render(include_str!("../../../shaders/wireframe.wgsl")),
+        "markers" => render(include_str!("../../../shaders/markers.wgsl")),
+        "tool" => render(include_str!("../../../shaders/tool.wgsl")),
+        "skin_deform" => include_str!("../../../shaders/skin_deform.wgsl").to_string(),
+        "skin_normals" => include_str!("../../../shaders/skin_normals.wgsl").to_string(),
+        _ => return None,
+    })
+}
+
+/// A shader module for `name` (which must be one of [`RENDER_SHADERS`] or
+/// [`COMPUTE_SHADERS`]).
+pub(crate) fn module(device: &wgpu::Device, name: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(source(name).unwrap_or_default().into()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every renderer shader parses and validates with naga, without an adapter.
+    #[test]
+    fn all_shaders_validate_with_naga() {
+        for name in RENDER_SHADERS.iter().chain(&COMPUTE_SHADERS) {
+            let src = source(name).unwrap();
+            let module = wgpu::naga::front::wgsl::parse_str(&src)
+                .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&src)));
+            wgpu::naga::valid::Validator::new(
+                wgpu::naga::valid::ValidationFlags::all(),
+                wgpu::naga::valid::Capabilities::empty(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&src)));
+        }
+        assert!(source("nonexistent").is_none());
+    }
+}

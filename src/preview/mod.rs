@@ -1,0 +1,401 @@
+//! `incise preview`: the desktop window (winit) with the incise-xr renderer, an egui
+//! side panel and orbit/pan/zoom. `--frames N` renders N frames and exits (for tests and
+//! scripts); `--screenshot FILE` saves the window's last frame.
+
+mod camera_input;
+pub mod display;
+mod frame_times;
+mod panel;
+mod session;
+mod window_gpu;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context, Result, anyhow, bail};
+use incise_xr::{BodyState, Camera, RenderSettings, Renderer};
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::window::{Fullscreen, Window, WindowId};
+
+use crate::body::{Body, DeviceChoice};
+use crate::screenshots::{ImageSize, default_camera, stress_scale};
+
+/// The preview's start view: the default one, a little farther out (the panel takes room).
+fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
+    let mut cam = default_camera(mesh);
+    cam.zoom(1.3);
+    cam
+}
+use camera_input::{CameraInput, KeyAction};
+use frame_times::{FrameTime, FrameTimes};
+use panel::{Action, Panel, PanelInfo};
+use session::{Session, scene_files};
+use window_gpu::{PanelFrame, WindowGpu};
+
+/// Options of `incise preview`.
+#[derive(Debug, Clone)]
+pub struct PreviewOptions {
+    /// Scene to open.
+    pub scene: PathBuf,
+    /// Render this many frames, then exit.
+    pub frames: Option<u64>,
+    /// Save the window's last frame here (PNG) when exiting.
+    pub screenshot: Option<PathBuf>,
+    /// Where the solver runs (auto: the render device's GPU when it is not a software one).
+    pub device: DeviceChoice,
+    /// Window size.
+    pub size: ImageSize,
+}
+
+/// Open the preview window and run until it is closed (or `--frames` are done).
+pub fn run(opts: PreviewOptions) -> Result<()> {
+    if let Some(why) = display::missing_display() {
+        bail!("{why}: the preview needs a window; use `incise run` or `incise render` headless");
+    }
+    let event_loop = EventLoop::new().map_err(|e| anyhow!("cannot open a window: {e}"))?;
+    let mut app = App {
+        opts,
+        live: None,
+        result: Ok(()),
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| anyhow!("window event loop: {e}"))?;
+    app.result
+}
+
+struct App {
+    opts: PreviewOptions,
+    live: Option<Live>,
+    result: Result<()>,
+}
+
+/// Everything that exists while the window is open.
+struct Live {
+    window: Arc<Window>,
+    gpu: WindowGpu,
+    session: Session,
+    renderer: Renderer,
+    egui: egui::Context,
+    egui_winit: egui_winit::State,
+    camera: Camera,
+    home: Camera,
+    input: CameraInput,
+    panel: Panel,
+    times: FrameTimes,
+    last_frame: Instant,
+    frames_drawn: u64,
+    capture_next: bool,
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.live.is_some() {
+            return;
+        }
+        match Live::open(event_loop, &self.opts) {
+            Ok(l) => self.live = Some(l),
+            Err(e) => {
+                self.result = Err(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(live) = &mut self.live else { return };
+        let consumed = live
+            .egui_winit
+            .on_window_event(&live.window, &event)
+            .consumed;
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(s) => live.gpu.resize(s.width, s.height),
+            WindowEvent::RedrawRequested => match live.frame(&self.opts) {
+                Ok(true) => {}
+                Ok(false) => event_loop.exit(),
+                Err(e) => {
+                    self.result = Err(e);
+                    event_loop.exit();
+                }
+            },
+            WindowEvent::ModifiersChanged(m) => live.input.set_shift(m.state().shift_key()),
+            WindowEvent::MouseInput { state, button, .. }
+                if !consumed || state == ElementState::Released =>
+            {
+                live.input.button(button, state);
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let h = live.window.inner_size().height as f64;
+                live.input
+                    .cursor(&mut live.camera, position.x, position.y, h);
+            }
+            WindowEvent::MouseWheel { delta, .. } if !consumed => {
+                live.input.wheel(&mut live.camera, delta);
+            }
+            WindowEvent::KeyboardInput { event, .. }
+                if !consumed && event.state == ElementState::Pressed =>
+            {
+                match live
+                    .input
+                    .key(&mut live.camera, &live.home, &event.logical_key)
+                {
+                    KeyAction::None => {}
+                    KeyAction::PlayPause => live.panel.playing = !live.panel.playing,
+                    KeyAction::Quit => event_loop.exit(),
+                    KeyAction::Fullscreen => {
+                        let full = live
+                            .window
+                            .fullscreen()
+                            .is_none()
+                            .then_some(Fullscreen::Borderless(None));
+                        live.window.set_fullscreen(full);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        if let Some(live) = &self.live {
+            live.window.request_redraw();
+        }
+    }
+}
+
+impl Live {
+    fn open(event_loop: &ActiveEventLoop, opts: &PreviewOptions) -> Result<Live> {
+        let attrs = Window::default_attributes()
+            .with_title("incise preview")
+            .with_inner_size(winit::dpi::PhysicalSize::new(opts.size.0, opts.size.1));
+        let window = Arc::new(
+            event_loop
+                .create_window(attrs)
+                .map_err(|e| anyhow!("cannot open a window: {e}"))?,
+        );
+        let gpu = WindowGpu::new(window.clone())?;
+        let device = match opts.device {
+            // A software adapter runs the CPU solver faster than its own compute.
+            DeviceChoice::Auto if gpu.dev.info.device_type == wgpu::DeviceType::Cpu => {
+                DeviceChoice::Cpu
+            }
+            DeviceChoice::Auto => DeviceChoice::Gpu,
+            d => d,
+        };
+        let session = Session::load(&opts.scene, device, &gpu.dev)?;
+        let renderer = Renderer::new(
+            &gpu.dev.device,
+            &gpu.dev.queue,
+            gpu.format(),
+            session.body.solver().mesh(),
+            &session.skin,
+        );
+        let egui = egui::Context::default();
+        let egui_winit = egui_winit::State::new(
+            egui.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(gpu.dev.limits.max_texture_dimension_2d as usize),
+        );
+        let home = preview_camera(session.body.solver().mesh());
+        let scene_dir = opts
+            .scene
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        Ok(Live {
+            panel: Panel {
+                scenes: scene_files(scene_dir),
+                playing: true,
+                draft: session.params,
+                device,
+                overlays: Default::default(),
+                message: String::new(),
+            },
+            window,
+            gpu,
+            session,
+            renderer,
+            egui,
+            egui_winit,
+            camera: home,
+            home,
+            input: CameraInput::default(),
+            times: FrameTimes::default(),
+            last_frame: Instant::now(),
+            frames_drawn: 0,
+            capture_next: false,
+        })
+    }
+
+    /// One frame; `Ok(false)` when the preview should close.
+    fn frame(&mut self, opts: &PreviewOptions) -> Result<bool> {
+        let now = Instant::now();
+        let frame_ms = (now - self.last_frame).as_secs_f64() * 1e3;
+        self.last_frame = now;
+        let mut sim_ms = 0.0;
+        if self.panel.playing {
+            match self.session.step() {
+                Ok((_, ms)) => sim_ms = ms,
+                Err(e) => {
+                    self.panel.playing = false;
+                    self.panel.message = format!("solver stopped: {e}");
+                }
+            }
+        }
+        let t_render = Instant::now();
+        let solver = self.session.body.solver();
+        let info = PanelInfo {
+            scene: &self.session.path,
+            frame: solver.frame(),
+            released: solver.cut().released_count(),
+            max_stress: solver.von_mises().iter().copied().fold(0.0, f32::max),
+            stress_max: stress_scale(solver),
+            device: self.session.body.device(),
+            times: &self.times,
+        };
+        let input = self.egui_winit.take_egui_input(&self.window);
+        let panel = &mut self.panel;
+        let (mut actions, mut panel_points) = (Vec::new(), 0.0);
+        let out = self
+            .egui
+            .run_ui(input, |ui| (actions, panel_points) = panel.ui(ui, &info));
+        self.egui_winit
+            .handle_platform_output(&self.window, out.platform_output);
+        let jobs = self.egui.tessellate(out.shapes, out.pixels_per_point);
+        for a in actions {
+            self.act(a)?;
+        }
+        let last = opts.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
+        let capture = self.capture_next || (last && opts.screenshot.is_some());
+        let solver = self.session.body.solver();
+        let mut state = BodyState::of_solver(solver, &self.session.pinned);
+        if let Body::Gpu(g) = &self.session.body {
+            state.device_positions = Some(g.position_buffer());
+        }
+        let settings = RenderSettings {
+            overlays: self.panel.overlays,
+            stress_max: stress_scale(solver),
+            ..RenderSettings::default()
+        };
+        let (w, h) = self.gpu.size();
+        let mut view = self.camera.view(w as f32 / h.max(1) as f32);
+        // Centre the scene in the part of the window the panel leaves free.
+        let shift = panel_points * out.pixels_per_point / w.max(1) as f32;
+        view.proj = glam::Mat4::from_translation(glam::Vec3::new(shift, 0.0, 0.0)) * view.proj;
+        let drawn = self.gpu.draw(
+            &mut self.renderer,
+            &state,
+            &settings,
+            &view,
+            PanelFrame {
+                jobs,
+                textures: out.textures_delta,
+                pixels_per_point: out.pixels_per_point,
+            },
+            capture,
+        )?;
+        let Some(image) = drawn else {
+            return Ok(true);
+        };
+        self.frames_drawn += 1;
+        self.times.push(FrameTime {
+            sim_ms,
+            render_ms: t_render.elapsed().as_secs_f64() * 1e3,
+            frame_ms,
+        });
+        if capture {
+            self.capture_next = false;
+            let path = match (&opts.screenshot, last) {
+                (Some(p), true) => p.clone(),
+                _ => PathBuf::from("screenshots").join(format!(
+                    "{}_f{:05}.png",
+                    self.session.name(),
+                    self.session.body.solver().frame()
+                )),
+            };
+            match image {
+                Some(img) => {
+                    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                        std::fs::create_dir_all(dir)
+                            .with_context(|| format!("creating {}", dir.display()))?;
+                    }
+                    img.save_png(&path)?;
+                    self.panel.message = format!("saved {}", path.display());
+                }
+                None => {
+                    let msg = "this window surface cannot be read back for screenshots; use `incise render`";
+                    if last {
+                        bail!(msg);
+                    }
+                    self.panel.message = msg.into();
+                }
+            }
+        }
+        Ok(!last)
+    }
+
+    fn act(&mut self, action: Action) -> Result<()> {
+        let dev = &self.gpu.dev;
+        let result = match action {
+            Action::Load(path) => Session::load(&path, self.session.device, dev).map(|s| {
+                self.renderer = Renderer::new(
+                    &dev.device,
+                    &dev.queue,
+                    self.gpu.format(),
+                    s.body.solver().mesh(),
+                    &s.skin,
+                );
+                self.home = preview_camera(s.body.solver().mesh());
+                self.camera = self.home;
+                self.panel.draft = s.params;
+                self.session = s;
+                "loaded".to_string()
+            }),
+            Action::Step => self
+                .session
+                .step()
+                .map(|_| String::new())
+                .map_err(|e| anyhow!(e)),
+            Action::Reset => self.session.reset(dev).map(|()| "reset".into()),
+            Action::Apply(params, device) => self
+                .session
+                .apply(params, device, dev)
+                .map(|()| "settings applied".into()),
+            Action::ResetView => {
+                self.camera = self.home;
+                Ok(String::new())
+            }
+            Action::Screenshot => {
+                self.capture_next = true;
+                Ok(String::new())
+            }
+            Action::SaveVtu => self.save_vtu(),
+        };
+        match result {
+            Ok(msg) if !msg.is_empty() => self.panel.message = msg,
+            Ok(_) => {}
+            Err(e) => {
+                self.panel.message = format!("{e:#}");
+                self.panel.draft = self.session.params;
+                self.panel.device = self.session.device;
+            }
+        }
+        Ok(())
+    }
+
+    fn save_vtu(&self) -> Result<String> {
+        let dir = PathBuf::from("out/preview");
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        let solver = self.session.body.solver();
+        let mut pvd = Vec::new();
+        crate::run::snapshot(&dir, solver, solver.frame(), &mut pvd)?;
+        Ok(format!("saved {}", dir.join(&pvd[0].1).display()))
+    }
+}

@@ -1,0 +1,307 @@
+//! The egui side panel: scene picker, play/pause/step/reset, live material and solver
+//! settings, device, overlays with the stress legend, the frame-time graph, and buttons
+//! for screenshots and `.vtu` snapshots. It only reports what the user asked for.
+
+use std::path::PathBuf;
+
+use egui::{Color32, Pos2, Rect, Stroke, Vec2};
+use incise_xr::Overlays;
+use incise_xr::colour_map::turbo;
+
+use super::frame_times::FrameTimes;
+use super::session::LiveParams;
+use crate::body::DeviceChoice;
+
+/// What the user asked for this frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Open another scene.
+    Load(PathBuf),
+    /// Advance one frame (while paused).
+    Step,
+    /// Start the scene over.
+    Reset,
+    /// Apply changed settings or device to the running body.
+    Apply(LiveParams, DeviceChoice),
+    /// Put the camera back to its start.
+    ResetView,
+    /// Save a screenshot of the window.
+    Screenshot,
+    /// Save the body as a `.vtu`.
+    SaveVtu,
+}
+
+/// Panel state that persists between frames.
+pub struct Panel {
+    /// Scene files offered.
+    pub scenes: Vec<PathBuf>,
+    /// Whether the simulation runs.
+    pub playing: bool,
+    /// Settings as edited.
+    pub draft: LiveParams,
+    /// Device as chosen.
+    pub device: DeviceChoice,
+    /// Overlays shown.
+    pub overlays: Overlays,
+    /// Status line (last save, last error).
+    pub message: String,
+}
+
+/// What the panel shows about the running scene.
+pub struct PanelInfo<'a> {
+    /// Scene file in use.
+    pub scene: &'a std::path::Path,
+    /// Simulation frame.
+    pub frame: u64,
+    /// Released tets.
+    pub released: usize,
+    /// Largest von Mises stress now, Pa.
+    pub max_stress: f32,
+    /// Top of the heat-map scale, Pa.
+    pub stress_max: f32,
+    /// "cpu" or the GPU adapter.
+    pub device: String,
+    /// Recent timings.
+    pub times: &'a FrameTimes,
+}
+
+impl Panel {
+    /// Draw the panel into `ui`; returns the actions asked for and the panel's width in
+    /// points.
+    pub fn ui(&mut self, ui: &mut egui::Ui, info: &PanelInfo<'_>) -> (Vec<Action>, f32) {
+        let mut actions = Vec::new();
+        let shown = egui::Panel::left("controls")
+            .default_size(270.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    self.scene_section(ui, info, &mut actions);
+                    ui.separator();
+                    self.settings_section(ui, &mut actions);
+                    ui.separator();
+                    self.overlay_section(ui, info);
+                    ui.separator();
+                    timing_section(ui, info);
+                    ui.separator();
+                    ui.horizontal(|ui| {
+                        if ui.button("Screenshot").clicked() {
+                            actions.push(Action::Screenshot);
+                        }
+                        if ui.button("Save .vtu").clicked() {
+                            actions.push(Action::SaveVtu);
+                        }
+                        if ui.button("Reset view").clicked() {
+                            actions.push(Action::ResetView);
+                        }
+                    });
+                    ui.label("Stroke recording waits for the scalpel (issue 5).");
+                    if !self.message.is_empty() {
+                        ui.separator();
+                        ui.label(&self.message);
+                    }
+                    ui.separator();
+                    ui.small("Drag: orbit · middle/shift-drag: pan · wheel: zoom · R: reset view · F: fullscreen · Space: play");
+                });
+            });
+        (actions, shown.response.rect.width())
+    }
+
+    fn scene_section(
+        &mut self,
+        ui: &mut egui::Ui,
+        info: &PanelInfo<'_>,
+        actions: &mut Vec<Action>,
+    ) {
+        ui.heading("Scene");
+        let current = file_name(info.scene);
+        egui::ComboBox::from_label("")
+            .selected_text(current.clone())
+            .show_ui(ui, |ui| {
+                for s in &self.scenes {
+                    let name = file_name(s);
+                    if ui.selectable_label(name == current, name).clicked() {
+                        actions.push(Action::Load(s.clone()));
+                    }
+                }
+            });
+        ui.horizontal(|ui| {
+            let label = if self.playing { "Pause" } else { "Play" };
+            if ui.button(label).clicked() {
+                self.playing = !self.playing;
+            }
+            if ui
+                .add_enabled(!self.playing, egui::Button::new("Step"))
+                .clicked()
+            {
+                actions.push(Action::Step);
+            }
+            if ui.button("Reset").clicked() {
+                actions.push(Action::Reset);
+            }
+        });
+        ui.label(format!(
+            "frame {} · {} tets released · max σvM {:.0} Pa",
+            info.frame, info.released, info.max_stress
+        ));
+    }
+
+    fn settings_section(&mut self, ui: &mut egui::Ui, actions: &mut Vec<Action>) {
+        ui.heading("Material and solver");
+        let d = &mut self.draft;
+        let slider = |ui: &mut egui::Ui, s: egui::Slider<'_>| {
+            let r = ui.add(s);
+            r.drag_stopped() || (r.changed() && !r.dragged())
+        };
+        let mut done = false;
+        done |= slider(
+            ui,
+            egui::Slider::new(&mut d.youngs_modulus, 1e3..=1e6)
+                .logarithmic(true)
+                .text("E (Pa)"),
+        );
+        done |= slider(
+            ui,
+            egui::Slider::new(&mut d.poisson_ratio, 0.0..=0.49).text("ν"),
+        );
+        done |= slider(
+            ui,
+            egui::Slider::new(&mut d.damping, 0.0..=50.0).text("damping (1/s)"),
+        );
+        done |= slider(
+            ui,
+            egui::Slider::new(&mut d.substeps, 1..=400).text("substeps"),
+        );
+        let mut cutting = d.cut_threshold.is_some();
+        let toggled = ui.checkbox(&mut cutting, "cutting").changed();
+        done |= toggled;
+        if cutting {
+            let mut t = d.cut_threshold.unwrap_or(1e5);
+            done |= slider(
+                ui,
+                egui::Slider::new(&mut t, 1e2..=1e7)
+                    .logarithmic(true)
+                    .text("cut σvM (Pa)"),
+            );
+            d.cut_threshold = Some(t);
+        } else {
+            d.cut_threshold = None;
+        }
+        ui.horizontal(|ui| {
+            ui.label("device");
+            for (choice, name) in [(DeviceChoice::Cpu, "cpu"), (DeviceChoice::Gpu, "gpu")] {
+                if ui
+                    .selectable_value(&mut self.device, choice, name)
+                    .clicked()
+                {
+                    done = true;
+                }
+            }
+        });
+        if done {
+            actions.push(Action::Apply(self.draft, self.device));
+        }
+    }
+
+    fn overlay_section(&mut self, ui: &mut egui::Ui, info: &PanelInfo<'_>) {
+        ui.heading("Overlays");
+        let o = &mut self.overlays;
+        ui.checkbox(&mut o.stress, "von Mises heat map");
+        if o.stress {
+            legend(ui, info.stress_max);
+        }
+        ui.checkbox(&mut o.wireframe, "tet wireframe");
+        ui.checkbox(
+            &mut o.tool_spheres,
+            "tool spheres (with the scalpel, issue 5)",
+        );
+        ui.checkbox(&mut o.pinned, "pinned nodes");
+    }
+}
+
+fn file_name(p: &std::path::Path) -> String {
+    p.file_name().map_or_else(
+        || p.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+/// The heat map's colour bar from 0 to `max` Pa.
+fn legend(ui: &mut egui::Ui, max: f32) {
+    let (rect, _) = ui.allocate_exact_size(
+        Vec2::new(ui.available_width().min(240.0), 14.0),
+        egui::Sense::hover(),
+    );
+    let n = 48;
+    for i in 0..n {
+        let t = i as f32 / (n - 1) as f32;
+        let c = turbo(t).map(|v| (v * 255.0) as u8);
+        let x0 = rect.left() + rect.width() * i as f32 / n as f32;
+        let x1 = rect.left() + rect.width() * (i + 1) as f32 / n as f32;
+        ui.painter().rect_filled(
+            Rect::from_min_max(
+                Pos2::new(x0, rect.top()),
+                Pos2::new(x1 + 0.5, rect.bottom()),
+            ),
+            0.0,
+            Color32::from_rgb(c[0], c[1], c[2]),
+        );
+    }
+    ui.horizontal(|ui| {
+        ui.small("0 Pa");
+        ui.add_space(ui.available_width() - 90.0);
+        ui.small(format!("{max:.3e} Pa"));
+    });
+}
+
+/// Picks one timing out of a frame.
+type Series = fn(&super::frame_times::FrameTime) -> f64;
+
+/// Frame-time graph: sim (orange), render (blue) and whole frame (grey), ms.
+fn timing_section(ui: &mut egui::Ui, info: &PanelInfo<'_>) {
+    ui.heading("Frame time");
+    let m = info.times.recent_mean();
+    ui.label(format!(
+        "sim {:.1} ms · render {:.1} ms · {:.0} fps",
+        m.sim_ms,
+        m.render_ms,
+        info.times.fps()
+    ));
+    ui.small(&info.device);
+    let (rect, _) = ui.allocate_exact_size(
+        Vec2::new(ui.available_width().min(240.0), 70.0),
+        egui::Sense::hover(),
+    );
+    let p = ui.painter();
+    p.rect_filled(rect, 2.0, Color32::from_gray(24));
+    let frames: Vec<_> = info.times.frames().copied().collect();
+    let top = frames
+        .iter()
+        .map(|f| f.frame_ms.max(f.sim_ms).max(f.render_ms))
+        .fold(16.7, f64::max);
+    let n = frames.len().max(2);
+    let point = |i: usize, v: f64| {
+        Pos2::new(
+            rect.left() + rect.width() * i as f32 / (n - 1) as f32,
+            rect.bottom() - rect.height() * (v / top) as f32,
+        )
+    };
+    let series: [(Series, Color32); 3] = [
+        (|f| f.frame_ms, Color32::from_gray(150)),
+        (|f| f.sim_ms, Color32::from_rgb(240, 150, 40)),
+        (|f| f.render_ms, Color32::from_rgb(80, 160, 250)),
+    ];
+    for (get, colour) in series {
+        let pts: Vec<Pos2> = frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| point(i, get(f)))
+            .collect();
+        p.add(egui::Shape::line(pts, Stroke::new(1.0, colour)));
+    }
+    p.text(
+        rect.left_top() + Vec2::new(3.0, 2.0),
+        egui::Align2::LEFT_TOP,
+        format!("{top:.0} ms"),
+        egui::FontId::proportional(10.0),
+        Color32::from_gray(180),
+    );
+}

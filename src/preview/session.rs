@@ -1,0 +1,235 @@
+//! The simulation behind the preview: the chosen scene, its body on the chosen device,
+//! stepping, reset, and material/solver settings changed while it runs (the body is
+//! rebuilt around the current positions, cut and grab progress).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use glam::Vec3;
+use incise_sim::grab::Grab;
+use incise_sim::skin::Skin;
+use incise_sim::xpbd::FrameStats;
+use incise_sim::{Material, Solver};
+use incise_xr::RenderDevice;
+
+use crate::body::{Body, DeviceChoice};
+use crate::scene::{Scene, build_scene, load_scene};
+use crate::screenshots::place_on;
+
+/// Settings the panel changes while the scene runs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LiveParams {
+    /// Young's modulus, Pa.
+    pub youngs_modulus: f32,
+    /// Poisson ratio.
+    pub poisson_ratio: f32,
+    /// Velocity damping, 1/s.
+    pub damping: f32,
+    /// von Mises cut threshold, Pa (`None`: no cutting).
+    pub cut_threshold: Option<f32>,
+    /// Substeps per frame.
+    pub substeps: u32,
+}
+
+/// A scene running in the preview.
+pub struct Session {
+    /// The scene file.
+    pub path: PathBuf,
+    scene: Scene,
+    /// The body.
+    pub body: Body,
+    /// The skin embedded in the body's mesh.
+    pub skin: Skin,
+    /// The device the body runs on (cpu or gpu).
+    pub device: DeviceChoice,
+    /// Settings in force.
+    pub params: LiveParams,
+    /// Pinned nodes.
+    pub pinned: Vec<u32>,
+    /// Density of the material, kg/m³ (not editable).
+    density: f32,
+    /// The last solver failure, shown in the panel.
+    pub error: Option<String>,
+}
+
+/// `.ron` scene files in `dir` (not `materials.ron`), sorted.
+pub fn scene_files(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "ron")
+                && p.file_name().is_some_and(|n| n != "materials.ron")
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+impl Session {
+    /// Load `path` and put its body on `device` (the GPU one on `dev`).
+    pub fn load(path: &Path, device: DeviceChoice, dev: &RenderDevice) -> Result<Session> {
+        let scene = load_scene(path)?;
+        let built = build_scene(&scene, path, None)?;
+        let p = built.solver.params().clone();
+        let params = LiveParams {
+            youngs_modulus: built.material.youngs_modulus,
+            poisson_ratio: built.material.poisson_ratio,
+            damping: p.damping,
+            cut_threshold: p.release_threshold,
+            substeps: p.substeps,
+        };
+        let pinned = incise_xr::frame::pinned_nodes(&built.solver);
+        Ok(Session {
+            path: path.to_path_buf(),
+            density: built.material.density,
+            body: place_on(built.solver, device, dev)?,
+            skin: built.skin,
+            scene,
+            device,
+            params,
+            pinned,
+            error: None,
+        })
+    }
+
+    /// The scene's name.
+    pub fn name(&self) -> &str {
+        &self.scene.name
+    }
+
+    /// Step one frame; a solver failure is kept in [`Session::error`] and returned.
+    pub fn step(&mut self) -> Result<(FrameStats, f64), String> {
+        let t0 = Instant::now();
+        match self.body.step_frame() {
+            Ok(s) => Ok((s, t0.elapsed().as_secs_f64() * 1e3)),
+            Err(e) => {
+                let msg = e.to_string();
+                self.error = Some(msg.clone());
+                Err(msg)
+            }
+        }
+    }
+
+    /// Start over from rest with the current settings.
+    pub fn reset(&mut self, dev: &RenderDevice) -> Result<()> {
+        let solver = self.fresh_solver(None)?;
+        self.body = place_on(solver, self.device, dev)?;
+        self.error = None;
+        Ok(())
+    }
+
+    /// Apply `params` (and `device`) to the running body: a new solver with the new
+    /// material and settings continues from the current positions, cut and grab
+    /// progress. Refused settings (unstable, out of range) leave the body as it was.
+    pub fn apply(
+        &mut self,
+        params: LiveParams,
+        device: DeviceChoice,
+        dev: &RenderDevice,
+    ) -> Result<()> {
+        let old = self.params;
+        self.params = params;
+        let solver = match self.fresh_solver(Some(self.body.solver())) {
+            Ok(s) => s,
+            Err(e) => {
+                self.params = old;
+                return Err(e);
+            }
+        };
+        self.body = place_on(solver, device, dev)?;
+        self.device = device;
+        Ok(())
+    }
+
+    /// A solver for this scene with the current settings; from rest, or continuing `from`.
+    fn fresh_solver(&self, from: Option<&Solver>) -> Result<Solver> {
+        let cur = self.body.solver();
+        let material = Material {
+            youngs_modulus: self.params.youngs_modulus,
+            poisson_ratio: self.params.poisson_ratio,
+            density: self.density,
+        };
+        let mut sp = cur.params().clone();
+        sp.damping = self.params.damping;
+        sp.release_threshold = self.params.cut_threshold;
+        sp.substeps = self.params.substeps;
+        let mesh = cur.mesh().clone();
+        let rest = mesh.rest_positions.clone();
+        let mut s =
+            Solver::new(mesh, material, sp).with_context(|| self.path.display().to_string())?;
+        let t = from.map_or(0.0, |f| f.time());
+        if let Some(f) = from {
+            s.set_positions(f.positions());
+            let released: Vec<u32> = (0..f.mesh().tet_count())
+                .filter(|&i| !f.cut().is_live(i))
+                .map(|i| i as u32)
+                .collect();
+            s.release(&released);
+        }
+        s.pin(&self.pinned);
+        for (i, g) in self.scene.grabs.iter().enumerate() {
+            let nodes = g
+                .nodes
+                .select(&rest)
+                .with_context(|| format!("{}: grabs[{i}].nodes", self.path.display()))?;
+            let grab = Grab {
+                nodes,
+                waypoints: g.path.clone(),
+                speed: g.speed,
+                start_time: g.start,
+            };
+            s.add_grab(remaining(&grab, t));
+        }
+        Ok(s)
+    }
+}
+
+/// The rest of `g`'s path from time `t` on, as a grab starting at the nodes' positions
+/// then (its time origin moved to 0).
+pub fn remaining(g: &Grab, t: f64) -> Grab {
+    let now = g.offset_at(t);
+    let travelled = (g.speed as f64 * (t - g.start_time as f64)).max(0.0) as f32;
+    let (mut along, mut from) = (0.0f32, Vec3::ZERO);
+    let mut rest = Vec::new();
+    for &to in &g.waypoints {
+        along += (to - from).length();
+        if along > travelled {
+            rest.push(to - now);
+        }
+        from = to;
+    }
+    Grab {
+        nodes: g.nodes.clone(),
+        waypoints: rest,
+        speed: g.speed,
+        start_time: (g.start_time as f64 - t).max(0.0) as f32,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_remaining_path_continues_where_the_grab_is() {
+        let g = Grab {
+            nodes: vec![1, 2],
+            waypoints: vec![Vec3::X, Vec3::new(1.0, 1.0, 0.0)],
+            speed: 0.5,
+            start_time: 1.0,
+        };
+        for t in [0.0, 0.5, 2.0, 3.5, 10.0] {
+            let r = remaining(&g, t);
+            assert_eq!(r.nodes, g.nodes);
+            // From the split on, old offset = offset now + new offset.
+            for dt in [0.0, 0.3, 1.0, 2.5, 6.0] {
+                let old = g.offset_at(t + dt);
+                let new = g.offset_at(t) + r.offset_at(dt);
+                assert!((old - new).length() < 1e-5, "t {t} dt {dt}: {old} vs {new}");
+            }
+        }
+    }
+}

@@ -1,0 +1,242 @@
+//! The window's GPU side: a surface on the render device, the 3D view drawn by the
+//! incise-xr renderer straight into the swapchain image, the egui panel on top, and
+//! screenshots read back from that image before it is presented.
+
+use std::sync::Arc;
+
+use anyhow::{Result, anyhow};
+use incise_xr::{BodyState, RenderDevice, RenderSettings, Renderer, RgbaImage, View};
+use winit::window::Window;
+
+/// The egui output of one frame, ready to draw.
+pub struct PanelFrame {
+    /// Tessellated shapes.
+    pub jobs: Vec<egui::ClippedPrimitive>,
+    /// Font and image texture changes.
+    pub textures: egui::TexturesDelta,
+    /// Points → pixels.
+    pub pixels_per_point: f32,
+}
+
+/// Surface, device and the egui renderer of the preview window.
+pub struct WindowGpu {
+    /// The device (shared with a GPU body).
+    pub dev: RenderDevice,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    /// Whether swapchain images can be copied out (screenshots).
+    can_capture: bool,
+    egui: egui_wgpu::Renderer,
+}
+
+impl WindowGpu {
+    /// Open a device that can present to `window`.
+    pub fn new(window: Arc<Window>) -> Result<Self> {
+        let instance = wgpu::Instance::new(
+            wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(window.clone())),
+        );
+        let size = window.inner_size();
+        let surface = instance
+            .create_surface(window)
+            .map_err(|e| anyhow!("cannot draw into the window: {e}"))?;
+        let dev = pollster::block_on(RenderDevice::open(&instance, Some(&surface)))?;
+        let caps = surface.get_capabilities(&dev.adapter);
+        let format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| f.is_srgb())
+            .or(caps.formats.first().copied())
+            .ok_or_else(|| anyhow!("{} cannot present to this window", dev.describe()))?;
+        let can_capture = caps.usages.contains(wgpu::TextureUsages::COPY_SRC);
+        let mut usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        if can_capture {
+            usage |= wgpu::TextureUsages::COPY_SRC;
+        }
+        let config = wgpu::SurfaceConfiguration {
+            usage,
+            format,
+            color_space: wgpu::SurfaceColorSpace::Auto,
+            width: size.width.max(1),
+            height: size.height.max(1),
+            desired_maximum_frame_latency: 2,
+            present_mode: wgpu::PresentMode::AutoVsync,
+            alpha_mode: wgpu::CompositeAlphaMode::Auto,
+            view_formats: vec![],
+        };
+        surface.configure(&dev.device, &config);
+        let egui =
+            egui_wgpu::Renderer::new(&dev.device, format, egui_wgpu::RendererOptions::default());
+        Ok(WindowGpu {
+            dev,
+            surface,
+            config,
+            can_capture,
+            egui,
+        })
+    }
+
+    /// The swapchain's colour format.
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.config.format
+    }
+
+    /// The swapchain size, pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.config.width, self.config.height)
+    }
+
+    /// Follow a window resize.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        if width > 0 && height > 0 {
+            self.config.width = width;
+            self.config.height = height;
+            self.surface.configure(&self.dev.device, &self.config);
+        }
+    }
+
+    /// Draw one frame: the body through `view`, then the panel; with `capture`, also
+    /// return the finished image. `None` when no image could be acquired this time
+    /// (minimised, resized under us): the caller simply tries next frame.
+    pub fn draw(
+        &mut self,
+        renderer: &mut Renderer,
+        state: &BodyState<'_>,
+        settings: &RenderSettings,
+        view: &View,
+        panel: PanelFrame,
+        capture: bool,
+    ) -> Result<Option<Option<RgbaImage>>> {
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                return Ok(None);
+            }
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.dev.device, &self.config);
+                return Ok(None);
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                return Err(anyhow!("the window surface reported a validation error"));
+            }
+        };
+        let target = frame
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let (device, queue) = (&self.dev.device, &self.dev.queue);
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("preview frame"),
+        });
+        renderer.prepare(&mut enc, state, settings);
+        renderer.render(&mut enc, &[(*view, &target)], self.size());
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: panel.pixels_per_point,
+        };
+        for (id, deltas) in &panel.textures.set {
+            for delta in deltas {
+                self.egui.update_texture(device, queue, *id, delta);
+            }
+        }
+        let extra = self
+            .egui
+            .update_buffers(device, queue, &mut enc, &panel.jobs, &screen);
+        {
+            let mut pass = enc
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("panel"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &target,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                })
+                .forget_lifetime();
+            self.egui.render(&mut pass, &panel.jobs, &screen);
+        }
+        for id in &panel.textures.free {
+            self.egui.free_texture(id);
+        }
+        let staging =
+            (capture && self.can_capture).then(|| self.copy_out(&mut enc, &frame.texture));
+        queue.submit(extra.into_iter().chain([enc.finish()]));
+        let image = match staging {
+            Some((buffer, row)) => Some(self.read(&buffer, row)?),
+            None => None,
+        };
+        queue.present(frame);
+        Ok(Some(image))
+    }
+
+    fn copy_out(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+    ) -> (wgpu::Buffer, u32) {
+        let (w, h) = self.size();
+        let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buffer = self.dev.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("window capture"),
+            size: row as u64 * h as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        enc.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        (buffer, row)
+    }
+
+    fn read(&self, buffer: &wgpu::Buffer, row: u32) -> Result<RgbaImage> {
+        let (w, h) = self.size();
+        buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+        self.dev
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| anyhow!("window capture: {e}"))?;
+        let data = buffer
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| anyhow!("window capture: {e}"))?;
+        let bgra = matches!(
+            self.config.format,
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+        );
+        let mut pixels = Vec::with_capacity((w * h * 4) as usize);
+        for y in 0..h as usize {
+            for p in data[y * row as usize..][..w as usize * 4].chunks_exact(4) {
+                let (r, b) = if bgra { (p[2], p[0]) } else { (p[0], p[2]) };
+                pixels.extend_from_slice(&[r, p[1], b, 255]);
+            }
+        }
+        drop(data);
+        buffer.unmap();
+        Ok(RgbaImage {
+            width: w,
+            height: h,
+            pixels,
+        })
+    }
+}

@@ -1,0 +1,190 @@
+//! Offscreen pictures of a scene from the incise-xr renderer: `incise render` (one frame)
+//! and `incise run --screenshot-every K` (a PNG every K frames). No window needed; any
+//! wgpu adapter will do (lavapipe without a GPU).
+
+use std::path::Path;
+use std::str::FromStr;
+
+use anyhow::{Context, Result, anyhow};
+use clap::ValueEnum;
+use incise_sim::gpu::GpuSolver;
+use incise_sim::skin::Skin;
+use incise_sim::{Solver, TetMesh};
+use incise_xr::frame::pinned_nodes;
+use incise_xr::{
+    BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, View,
+};
+
+use crate::body::{Body, DeviceChoice};
+
+/// An image size `WIDTHxHEIGHT` given on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ImageSize(pub u32, pub u32);
+
+impl FromStr for ImageSize {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (w, h) = s
+            .split_once(['x', 'X'])
+            .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 1280x720, got \"{s}\""))?;
+        let parse = |v: &str| {
+            v.trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|&n| (1..=16384).contains(&n))
+                .ok_or_else(|| format!("\"{v}\" is not a size of 1 to 16384 pixels"))
+        };
+        Ok(ImageSize(parse(w)?, parse(h)?))
+    }
+}
+
+impl std::fmt::Display for ImageSize {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}x{}", self.0, self.1)
+    }
+}
+
+/// Overlays that can be switched on from the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OverlayArg {
+    /// von Mises heat map on the tet surface.
+    Stress,
+    /// Edges of the live tets.
+    Wireframe,
+    /// Pinned nodes.
+    Pinned,
+}
+
+/// The overlay switches for a list of `--overlay` values.
+pub fn overlays(list: &[OverlayArg]) -> Overlays {
+    Overlays {
+        stress: list.contains(&OverlayArg::Stress),
+        wireframe: list.contains(&OverlayArg::Wireframe),
+        pinned: list.contains(&OverlayArg::Pinned),
+        tool_spheres: false,
+    }
+}
+
+/// The default view of a mesh: from the front left and above, the whole rest mesh in view.
+pub fn default_camera(mesh: &TetMesh) -> Camera {
+    let (lo, hi) = mesh.rest_bounds();
+    let mut cam = Camera::framing(lo, hi, -1.1, 0.6);
+    cam.zoom(0.75);
+    cam
+}
+
+/// The stress at the top of the heat-map scale: the cut threshold, else the largest
+/// stress now (at least 1 Pa).
+pub fn stress_scale(solver: &Solver) -> f32 {
+    solver
+        .params()
+        .release_threshold
+        .unwrap_or_else(|| solver.von_mises().iter().copied().fold(1.0, f32::max))
+}
+
+/// Put `solver` on the chosen device; a GPU body is opened on `dev`, so the renderer can
+/// copy its node positions on the device.
+pub fn place_on(solver: Solver, choice: DeviceChoice, dev: &RenderDevice) -> Result<Body> {
+    Ok(match choice {
+        DeviceChoice::Cpu => Body::Cpu(Box::new(solver)),
+        DeviceChoice::Gpu | DeviceChoice::Auto => {
+            Body::Gpu(Box::new(GpuSolver::new(solver, &dev.compute_context())?))
+        }
+    })
+}
+
+/// An offscreen renderer for one body with a fixed camera.
+pub struct Screenshots {
+    offscreen: OffscreenRenderer,
+    view: View,
+    settings: RenderSettings,
+    pinned: Vec<u32>,
+    /// Whether a GPU body lives on this renderer's device.
+    shared_device: bool,
+}
+
+impl Screenshots {
+    /// A `size` renderer for `solver`'s mesh and `skin` on `dev` (or a new headless device).
+    pub fn new(
+        dev: Option<&RenderDevice>,
+        solver: &Solver,
+        skin: &Skin,
+        size: ImageSize,
+        overlays: Overlays,
+    ) -> Result<Self> {
+        let own;
+        let dev = match dev {
+            Some(d) => d,
+            None => {
+                own = RenderDevice::headless()?;
+                &own
+            }
+        };
+        let offscreen = OffscreenRenderer::new(dev, solver.mesh(), skin, (size.0, size.1), 1)?;
+        let view = default_camera(solver.mesh()).view(offscreen.aspect());
+        Ok(Screenshots {
+            offscreen,
+            view,
+            settings: RenderSettings {
+                overlays,
+                stress_max: stress_scale(solver),
+                ..RenderSettings::default()
+            },
+            pinned: pinned_nodes(solver),
+            shared_device: false,
+        })
+    }
+
+    /// Declare that GPU bodies given to [`Screenshots::save`] live on this renderer's device.
+    pub fn with_shared_device(mut self) -> Self {
+        self.shared_device = true;
+        self
+    }
+
+    /// Render `body` now and write the PNG to `path`.
+    pub fn save(&mut self, body: &Body, path: &Path) -> Result<()> {
+        let solver = body.solver();
+        let mut state = BodyState::of_solver(solver, &self.pinned);
+        if let (Body::Gpu(g), true) = (body, self.shared_device) {
+            state.device_positions = Some(g.position_buffer());
+        }
+        let img = self
+            .offscreen
+            .render_image(&state, &self.settings, &self.view)?;
+        img.save_png(path)
+            .with_context(|| format!("writing screenshot {}", path.display()))
+    }
+}
+
+/// `incise render`: step `scene` for `frame` frames, render the frame, write `out`.
+pub fn render_frame(
+    scene_path: &Path,
+    frame: u64,
+    out: &Path,
+    size: ImageSize,
+    overlay: &[OverlayArg],
+    device: DeviceChoice,
+) -> Result<()> {
+    let scene = crate::scene::load_scene(scene_path)?;
+    let built = crate::scene::build_scene(&scene, scene_path, None)?;
+    let dev = RenderDevice::headless()
+        .map_err(|e| anyhow!("{e}"))
+        .context("incise render draws offscreen with wgpu")?;
+    let mut shots = Screenshots::new(
+        Some(&dev),
+        &built.solver,
+        &built.skin,
+        size,
+        overlays(overlay),
+    )?
+    .with_shared_device();
+    let mut body = place_on(built.solver, device, &dev)?;
+    for f in 0..frame {
+        body.step_frame()
+            .with_context(|| format!("{}: frame {f}", scene_path.display()))?;
+    }
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    shots.save(&body, out)
+}
