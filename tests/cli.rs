@@ -1,27 +1,11 @@
 //! End-to-end tests of the `incise` binary: runs, reports, snapshots, errors, mesh tools,
 //! benchmark JSON, and the shipped scenes.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn incise(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_incise"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("incise binary runs")
-}
+use common::{incise, temp_dir, text};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("incise-e2e-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn text(o: &[u8]) -> String {
-    String::from_utf8_lossy(o).into_owned()
-}
+use std::path::Path;
 
 /// A small tearing bar: pinned at x = 0, pulled along +x.
 const BAR: &str = r#"(

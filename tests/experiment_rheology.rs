@@ -2,23 +2,11 @@
 //! bad preset file exits 1 with a message naming the file, line and field, and writes no
 //! figures.
 
+mod common;
+
+use common::{incise, temp_dir};
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn incise(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_incise"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("incise binary runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("incise-rheo-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 #[test]
 fn missing_preset_file_is_a_clear_error() {

@@ -2,27 +2,9 @@
 //! runs and reports, a bad model field is named with its line, and the loop benchmark
 //! prints its JSON.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn incise(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_incise"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("incise binary runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("incise-nakao-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn text(o: &[u8]) -> String {
-    String::from_utf8_lossy(o).into_owned()
-}
+use common::{incise, temp_dir, text};
 
 #[test]
 fn shipped_nakao_scene_cuts_and_reports() {

@@ -6,21 +6,17 @@
 //! Needs `xvfb-run` (scripts/ensure-deps.sh installs it) and a wgpu adapter; without
 //! them the window test prints why and passes, unless `INCISE_REQUIRE_GPU=1` (CI).
 
+mod common;
+
+use common::temp_dir;
+
 use std::io::{BufRead, BufReader};
-use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
 use incise_xr::RgbaImage;
 
 fn required() -> bool {
     std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("incise-preview-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 #[test]

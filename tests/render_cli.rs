@@ -2,29 +2,13 @@
 //! `incise run --screenshot-every` (issue 6). They need a wgpu adapter (lavapipe in CI);
 //! without one they check for the clear error instead, unless `INCISE_REQUIRE_GPU=1`.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
+
+use common::{incise, temp_dir, text};
+
+use std::process::Output;
 
 use incise_xr::RgbaImage;
-
-fn incise(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_incise"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("incise binary runs")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("incise-render-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn text(o: &[u8]) -> String {
-    String::from_utf8_lossy(o).into_owned()
-}
 
 /// Whether rendering may be skipped here: no adapter and not required.
 fn no_adapter(o: &Output) -> bool {

@@ -142,7 +142,7 @@ pub fn run(opts: &NakaoBenchOptions) -> Result<()> {
     }
     results.push(summary("blade advance (cut)", &mut cut_ms, &[], None));
     let report = NakaoBench {
-        machine: machine(),
+        machine: crate::bench::machine(),
         mesh,
         results,
     };
@@ -170,19 +170,4 @@ pub fn run(opts: &NakaoBenchOptions) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// CPU model and logical core count (as `incise bench` prints them).
-fn machine() -> String {
-    let model = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    format!("{model}, {cores} logical cores")
 }

@@ -1,0 +1,27 @@
+//! Helpers shared by the end-to-end tests: run the `incise` binary, scratch folders, text.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// Run the built `incise` binary from the workspace root with `args`.
+pub fn incise(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_incise"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("incise binary runs")
+}
+
+/// A fresh, empty scratch folder unique to this test process and `name`.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("incise-e2e-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("create scratch folder");
+    d
+}
+
+/// Command output bytes as text.
+pub fn text(o: &[u8]) -> String {
+    String::from_utf8_lossy(o).into_owned()
+}
