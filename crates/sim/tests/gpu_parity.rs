@@ -9,23 +9,10 @@ mod common;
 
 use common::{block_mesh, soft, solver};
 use glam::{UVec3, Vec3};
-use incise_sim::gpu::{GpuContext, GpuSolver};
+use incise_sim::gpu::GpuSolver;
 use incise_sim::grab::Grab;
 use incise_sim::selection::NodeSelection;
 use incise_sim::{Solver, SolverParams};
-
-fn context() -> Option<GpuContext> {
-    match GpuContext::new() {
-        Ok(c) => Some(c),
-        Err(e) if std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-            panic!("INCISE_REQUIRE_GPU=1 but {e}")
-        }
-        Err(e) => {
-            eprintln!("skipping GPU test: {e}");
-            None
-        }
-    }
-}
 
 /// A 10 × 3 × 3 cm bar pinned at x = 0 and pulled at x = 10 cm until it tears.
 fn tearing_bar() -> Solver {
@@ -57,7 +44,9 @@ fn tearing_bar() -> Solver {
 
 #[test]
 fn gpu_matches_cpu_on_a_tearing_bar() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
     let mut cpu = tearing_bar();
     let mut gpu = GpuSolver::new(tearing_bar(), &ctx).expect("upload");
     let size = {
@@ -107,7 +96,9 @@ fn gpu_matches_cpu_on_a_tearing_bar() {
 /// Stationary rest state on the GPU (foundation test 2 on the device).
 #[test]
 fn gpu_rest_state_is_stationary() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
     let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.06, 0.03, 0.02), UVec3::new(6, 3, 2));
     let params = SolverParams {
         gravity: Vec3::ZERO,

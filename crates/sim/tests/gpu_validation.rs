@@ -9,30 +9,19 @@ mod common;
 
 use common::{block_mesh, soft, solver};
 use glam::{Mat3, UVec3, Vec3};
-use incise_sim::gpu::{GpuContext, GpuSolver};
+use incise_sim::gpu::GpuSolver;
 use incise_sim::grab::Grab;
 use incise_sim::selection::NodeSelection;
 use incise_sim::xpbd::deformation_gradient;
 use incise_sim::{Solver, SolverParams};
 
-fn context() -> Option<GpuContext> {
-    match GpuContext::new() {
-        Ok(c) => Some(c),
-        Err(e) if std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-            panic!("INCISE_REQUIRE_GPU=1 but {e}")
-        }
-        Err(e) => {
-            eprintln!("skipping GPU test: {e}");
-            None
-        }
-    }
-}
-
 /// Foundation test 5 on the GPU: every tet of a mirrored block starts inverted and the
 /// block returns to its rest shape.
 #[test]
 fn gpu_inverted_block_recovers() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
     let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.03, 0.03, 0.03), UVec3::new(3, 3, 3));
     let start: Vec<Vec3> = mesh
         .rest_positions
@@ -69,7 +58,9 @@ fn gpu_inverted_block_recovers() {
 /// Foundation test 4 on the GPU: ν = 0.49 block compressed 20 % keeps its volume (< 2 %).
 #[test]
 fn gpu_near_incompressible_block_keeps_volume() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
     let h = 0.02;
     let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.02, 0.02, h), UVec3::new(8, 8, 8));
     let params = SolverParams {
@@ -125,7 +116,9 @@ fn rss_kib() -> u64 {
 /// guard failure, and memory flat (no per-frame leak of buffers or mappings).
 #[test]
 fn gpu_soak_50000_frames_keeps_memory_flat() {
-    let Some(ctx) = context() else { return };
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
     let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.06, 0.02, 0.02), UVec3::new(6, 2, 2));
     // One substep per frame (a 50 Pa gel is stable at it): the soak exercises per-frame
     // resources (encoders, staging maps, readback), which one substep uses as ten do.

@@ -48,3 +48,19 @@ pub fn max_displacement(s: &Solver) -> f32 {
         .map(|(x, r)| (*x - *r).length())
         .fold(0.0, f32::max)
 }
+
+/// A wgpu device for GPU tests, or `None` (with the reason printed) when no adapter exists.
+/// With `INCISE_REQUIRE_GPU=1` (CI) a missing adapter fails the test instead.
+#[cfg(feature = "gpu")]
+pub fn gpu_context() -> Option<incise_sim::gpu::GpuContext> {
+    match incise_sim::gpu::GpuContext::new() {
+        Ok(c) => Some(c),
+        Err(e) if std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
+            panic!("INCISE_REQUIRE_GPU=1 but {e}")
+        }
+        Err(e) => {
+            eprintln!("skipping GPU test: {e}");
+            None
+        }
+    }
+}
