@@ -9,46 +9,16 @@ mod common;
 
 use common::{block_mesh, soft, solver};
 use glam::{UVec3, Vec3};
+use incise_sim::SolverParams;
 use incise_sim::gpu::GpuSolver;
-use incise_sim::grab::Grab;
-use incise_sim::selection::NodeSelection;
-use incise_sim::{Solver, SolverParams};
-
-/// A 10 × 3 × 3 cm bar pinned at x = 0 and pulled at x = 10 cm until it tears.
-fn tearing_bar() -> Solver {
-    let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6));
-    let params = SolverParams {
-        threads: 1,
-        release_threshold: Some(6e3),
-        ..SolverParams::default()
-    };
-    let mut s = solver(mesh, soft(30e3, 0.4), params);
-    let rest = s.mesh().rest_positions.clone();
-    let left = NodeSelection::PlaneSide {
-        point: Vec3::new(0.002, 0.0, 0.0),
-        normal: -Vec3::X,
-    };
-    s.pin(&left.select(&rest).unwrap());
-    let right = NodeSelection::PlaneSide {
-        point: Vec3::new(0.098, 0.0, 0.0),
-        normal: Vec3::X,
-    };
-    s.add_grab(Grab {
-        nodes: right.select(&rest).unwrap(),
-        waypoints: vec![Vec3::new(0.05, 0.0, 0.01)],
-        speed: 0.1,
-        start_time: 0.0,
-    });
-    s
-}
 
 #[test]
 fn gpu_matches_cpu_on_a_tearing_bar() {
     let Some(ctx) = common::gpu_context() else {
         return;
     };
-    let mut cpu = tearing_bar();
-    let mut gpu = GpuSolver::new(tearing_bar(), &ctx).expect("upload");
+    let mut cpu = common::tearing_bar(1);
+    let mut gpu = GpuSolver::new(common::tearing_bar(1), &ctx).expect("upload");
     let size = {
         let (lo, hi) = cpu.mesh().rest_bounds();
         (hi - lo).length()

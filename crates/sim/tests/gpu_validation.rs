@@ -10,7 +10,7 @@ mod common;
 use common::{block_mesh, soft, solver};
 use glam::{Mat3, UVec3, Vec3};
 use incise_sim::gpu::GpuSolver;
-use incise_sim::grab::Grab;
+use incise_sim::material::HydrostaticStiffness;
 use incise_sim::selection::NodeSelection;
 use incise_sim::xpbd::deformation_gradient;
 use incise_sim::{Solver, SolverParams};
@@ -61,32 +61,7 @@ fn gpu_near_incompressible_block_keeps_volume() {
     let Some(ctx) = common::gpu_context() else {
         return;
     };
-    let h = 0.02;
-    let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.02, 0.02, h), UVec3::new(8, 8, 8));
-    let params = SolverParams {
-        gravity: Vec3::ZERO,
-        substeps: 200,
-        damping: 20.0,
-        threads: 1,
-        ..SolverParams::default()
-    };
-    let mut s = solver(mesh, soft(10e3, 0.49), params);
-    let rest = s.mesh().rest_positions.clone();
-    let bottom = NodeSelection::PlaneSide {
-        point: Vec3::new(0.0, 0.0, 1e-4),
-        normal: -Vec3::Z,
-    };
-    let top = NodeSelection::PlaneSide {
-        point: Vec3::new(0.0, 0.0, h - 1e-4),
-        normal: Vec3::Z,
-    };
-    s.pin(&bottom.select(&rest).unwrap());
-    s.add_grab(Grab {
-        nodes: top.select(&rest).unwrap(),
-        waypoints: vec![Vec3::new(0.0, 0.0, -0.2 * h)],
-        speed: 0.02,
-        start_time: 0.0,
-    });
+    let (s, _) = common::compressed_cube(HydrostaticStiffness::Lambda, 1);
     let mut g = GpuSolver::new(s, &ctx).expect("upload");
     let mut last = None;
     for _ in 0..60 {

@@ -2,36 +2,10 @@
 
 mod common;
 
-use common::{block_mesh, soft, solver};
-use glam::{UVec3, Vec3};
-use incise_sim::SolverParams;
-use incise_sim::grab::Grab;
-use incise_sim::selection::NodeSelection;
+use glam::Vec3;
 
 fn run(threads: usize) -> (Vec<Vec3>, Vec<bool>) {
-    let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6));
-    let params = SolverParams {
-        threads,
-        release_threshold: Some(6e3),
-        ..SolverParams::default()
-    };
-    let mut s = solver(mesh, soft(30e3, 0.4), params);
-    let rest = s.mesh().rest_positions.clone();
-    let left = NodeSelection::PlaneSide {
-        point: Vec3::new(0.002, 0.0, 0.0),
-        normal: -Vec3::X,
-    };
-    s.pin(&left.select(&rest).unwrap());
-    let right = NodeSelection::PlaneSide {
-        point: Vec3::new(0.098, 0.0, 0.0),
-        normal: Vec3::X,
-    };
-    s.add_grab(Grab {
-        nodes: right.select(&rest).unwrap(),
-        waypoints: vec![Vec3::new(0.05, 0.0, 0.01)],
-        speed: 0.1,
-        start_time: 0.0,
-    });
+    let mut s = common::tearing_bar(threads);
     for _ in 0..40 {
         s.step_frame().unwrap();
     }

@@ -64,3 +64,76 @@ pub fn gpu_context() -> Option<incise_sim::gpu::GpuContext> {
         }
     }
 }
+
+/// Edge length of the compression test cube, m.
+pub const CUBE: f32 = 0.02;
+
+/// A ν = 0.49 cube of [`CUBE`] edge (8 cells per side, E = 10 kPa, 200 substeps, damping
+/// 20/s, no gravity): bottom face pinned, top face driven down by 20 % of the height at
+/// 2 cm/s (no-slip plates). Returns the solver and the top nodes.
+pub fn compressed_cube(
+    hydrostatic: incise_sim::material::HydrostaticStiffness,
+    threads: usize,
+) -> (Solver, Vec<u32>) {
+    use incise_sim::grab::Grab;
+    use incise_sim::selection::NodeSelection;
+    let mesh = block_mesh(Vec3::ZERO, Vec3::splat(CUBE), UVec3::new(8, 8, 8));
+    let params = SolverParams {
+        gravity: Vec3::ZERO,
+        substeps: 200,
+        damping: 20.0,
+        threads,
+        hydrostatic,
+        ..SolverParams::default()
+    };
+    let mut s = solver(mesh, soft(10e3, 0.49), params);
+    let rest = s.mesh().rest_positions.clone();
+    let bottom = NodeSelection::PlaneSide {
+        point: Vec3::new(0.0, 0.0, 1e-4),
+        normal: -Vec3::Z,
+    };
+    let top = NodeSelection::PlaneSide {
+        point: Vec3::new(0.0, 0.0, CUBE - 1e-4),
+        normal: Vec3::Z,
+    };
+    s.pin(&bottom.select(&rest).expect("bottom face"));
+    let top = top.select(&rest).expect("top face");
+    s.add_grab(Grab {
+        nodes: top.clone(),
+        waypoints: vec![Vec3::new(0.0, 0.0, -0.2 * CUBE)],
+        speed: 0.02,
+        start_time: 0.0,
+    });
+    (s, top)
+}
+
+/// A 10 × 3 × 3 cm bar (E = 30 kPa, ν = 0.4, release at 6 kPa) pinned at x = 0 and pulled
+/// from x = 10 cm along (5, 0, 1) cm at 10 cm/s until it tears.
+pub fn tearing_bar(threads: usize) -> Solver {
+    use incise_sim::grab::Grab;
+    use incise_sim::selection::NodeSelection;
+    let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6));
+    let params = SolverParams {
+        threads,
+        release_threshold: Some(6e3),
+        ..SolverParams::default()
+    };
+    let mut s = solver(mesh, soft(30e3, 0.4), params);
+    let rest = s.mesh().rest_positions.clone();
+    let left = NodeSelection::PlaneSide {
+        point: Vec3::new(0.002, 0.0, 0.0),
+        normal: -Vec3::X,
+    };
+    s.pin(&left.select(&rest).expect("left end"));
+    let right = NodeSelection::PlaneSide {
+        point: Vec3::new(0.098, 0.0, 0.0),
+        normal: Vec3::X,
+    };
+    s.add_grab(Grab {
+        nodes: right.select(&rest).expect("right end"),
+        waypoints: vec![Vec3::new(0.05, 0.0, 0.01)],
+        speed: 0.1,
+        start_time: 0.0,
+    });
+    s
+}
