@@ -5,6 +5,7 @@
 //! the scalpel enters the solver as plain sphere data. Equations are cited from
 //! `PHYSICS.md` (the project's restatement of the three source papers).
 
+pub mod contact;
 pub mod cutting;
 pub mod error;
 pub mod generate;

@@ -1,5 +1,6 @@
 //! Per-frame statistics reported by the solver.
 
+use glam::Vec3;
 use serde::Serialize;
 
 /// What one frame did, for report.json.
@@ -25,6 +26,10 @@ pub struct FrameStats {
     pub volume_ratio: f64,
     /// Kinetic energy ½ Σ m v², J.
     pub kinetic_energy: f64,
+    /// Mean force the tissue exerted on the tool this frame (x, y, z), N.
+    pub tool_force: Vec3,
+    /// Nodes in contact with the tool at the frame's last substep.
+    pub contact_nodes: usize,
     /// Wall time of the substeps (prediction, projection, velocity update), ms.
     pub solve_ms: f64,
     /// Wall time of stress, guards and release, ms.

@@ -4,6 +4,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::TetProjection;
+use crate::contact::{ContactError, CutZone};
 use crate::material::HydrostaticStiffness;
 
 /// Settings of the XPBD small-steps solver.
@@ -27,6 +28,9 @@ pub struct SolverParams {
     pub threads: usize,
     /// von Mises stress above which a tet is released, Pa; `None` disables cutting.
     pub release_threshold: Option<f32>,
+    /// Where the stress criterion may release tets: `Anywhere` (tearing) or
+    /// `NearEdge(reach: m)` (only where a cutting sphere passed).
+    pub cut_zone: CutZone,
     /// Frames a live tet may stay inverted before the run stops with an error.
     pub max_inverted_frames: u32,
 }
@@ -42,6 +46,7 @@ impl Default for SolverParams {
             hydrostatic: HydrostaticStiffness::Lambda,
             threads: 0,
             release_threshold: None,
+            cut_zone: CutZone::Anywhere,
             max_inverted_frames: 30,
         }
     }
@@ -79,6 +84,14 @@ impl SolverParams {
                 return bad(
                     "release_threshold",
                     format!("must be a positive stress in Pa, got {t}"),
+                );
+            }
+        }
+        if let CutZone::NearEdge { reach } = self.cut_zone {
+            if !(reach.is_finite() && reach >= 0.0) {
+                return bad(
+                    "cut_zone.reach",
+                    format!("must be a length >= 0 m, got {reach}"),
                 );
             }
         }
@@ -143,6 +156,9 @@ pub enum SolverError {
         /// Substeps per frame that would satisfy the bound.
         needed: u32,
     },
+    /// The tool cannot be used.
+    #[error(transparent)]
+    Tool(#[from] ContactError),
     /// The GPU device failed while stepping (device lost, readback failed).
     #[error("GPU: {0}")]
     Device(String),

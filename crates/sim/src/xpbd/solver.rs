@@ -12,6 +12,7 @@ use super::neo_hookean::{TetTerms, deformation_gradient_from_displacement, proje
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
 use super::{FrameStats, SolverError, SolverParams};
+use crate::contact::{ContactTool, CutZone, ToolMotion, ToolPose, project_node};
 use crate::cutting::{CutState, ReleaseEvent};
 use crate::grab::Grab;
 use crate::material::{Lame, Material};
@@ -70,6 +71,14 @@ pub struct Solver {
     pub(crate) det_f: Vec<f32>,
     pub(crate) inverted_frames: Vec<u32>,
     pub(crate) cut: CutState,
+    /// The tool, if one is attached, and its motion over the coming frame.
+    pub(crate) tool: Option<ToolMotion>,
+    /// Nodes that came within the cut reach of a cutting sphere this frame.
+    pub(crate) near_edge: Vec<bool>,
+    /// Σ m Δx of the contact projections this frame (tissue side), kg·m.
+    pub(crate) contact_impulse: Vec3,
+    /// Nodes the tool moved in the frame's last substep.
+    pub(crate) contact_nodes: usize,
     pub(crate) frame: u64,
     pub(crate) time: f64,
     pub(crate) pool: Option<rayon::ThreadPool>,
@@ -152,6 +161,10 @@ impl Solver {
             det_f: vec![1.0; t],
             inverted_frames: vec![0; t],
             cut: CutState::new(&mesh),
+            tool: None,
+            near_edge: vec![false; n],
+            contact_impulse: Vec3::ZERO,
+            contact_nodes: 0,
             frame: 0,
             time: 0.0,
             pool,
@@ -281,6 +294,41 @@ impl Solver {
         self.grabs.push(grab);
     }
 
+    /// Attach a tool at `pose` (replacing any previous one); it stays there until
+    /// [`Solver::move_tool`] moves it.
+    pub fn set_tool(&mut self, tool: ContactTool, pose: ToolPose) -> Result<(), SolverError> {
+        tool.validate()?;
+        self.tool = Some(ToolMotion {
+            tool,
+            from: pose,
+            to: pose,
+        });
+        Ok(())
+    }
+
+    /// Where the tool will be at the end of the next frame; it moves there continuously
+    /// over the frame's substeps (translation lerp, rotation slerp). No tool: ignored.
+    pub fn move_tool(&mut self, to: ToolPose) {
+        if let Some(m) = &mut self.tool {
+            m.to = to;
+        }
+    }
+
+    /// Detach the tool.
+    pub fn remove_tool(&mut self) {
+        self.tool = None;
+    }
+
+    /// The attached tool and its current motion.
+    pub fn tool(&self) -> Option<&ToolMotion> {
+        self.tool.as_ref()
+    }
+
+    /// Nodes that came within the cut reach of a cutting sphere during the last frame.
+    pub fn near_edge(&self) -> &[bool] {
+        &self.near_edge
+    }
+
     /// Release tets by hand (mesh indices); returns what changed.
     pub fn release(&mut self, tets: &[u32]) -> ReleaseEvent {
         let ev = self.cut.release(&self.mesh, tets);
@@ -302,6 +350,9 @@ impl Solver {
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
         let saved = (self.u.clone(), self.v.clone());
         let t0 = Instant::now();
+        self.near_edge.iter_mut().for_each(|b| *b = false);
+        self.contact_impulse = Vec3::ZERO;
+        self.contact_nodes = 0;
         match self.pool.take() {
             Some(pool) => {
                 pool.install(|| self.run_substeps(true));
@@ -329,6 +380,9 @@ impl Solver {
             return Err(e);
         }
         let released = self.release_overstressed();
+        if let Some(m) = &mut self.tool {
+            m.from = m.to;
+        }
         let mut stats = self.stats(released);
         stats.solve_ms = (t1 - t0).as_secs_f64() * 1e3;
         stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
@@ -338,14 +392,53 @@ impl Solver {
 
     fn run_substeps(&mut self, parallel: bool) {
         let h = self.params.substep();
-        for s in 0..self.params.substeps {
+        let n = self.params.substeps;
+        for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
             for c in 0..self.color_ranges.len() {
                 self.project_color(c, parallel);
             }
+            self.project_contacts(s, n);
             self.update_velocities(h);
         }
+    }
+
+    /// Push free nodes out of the tool as it moves through substep `s` of `n`
+    /// (PHYSICS.md §1.5, `C = d(x) ≥ 0`, zero compliance: `Δλ = m·|Δx|`).
+    ///
+    /// Projected after the tet constraints, not before as PHYSICS.md §1.2 lists them:
+    /// with one iteration per substep the last projection is the one that holds, and
+    /// this way every substep ends with no node inside the tool.
+    fn project_contacts(&mut self, s: u32, n: u32) {
+        let Some(motion) = &self.tool else {
+            return;
+        };
+        let from = motion.placed_at(s, n);
+        let to = motion.placed_at(s + 1, n);
+        let friction = motion.tool.friction;
+        let reach = match self.params.cut_zone {
+            CutZone::NearEdge { reach } => Some(reach),
+            CutZone::Anywhere => None,
+        };
+        let mut impulse = Vec3::ZERO;
+        let mut touched = 0;
+        for i in 0..self.u.len() {
+            if self.kind[i] != NodeKind::Free {
+                continue;
+            }
+            let rest = self.mesh.rest_positions[i];
+            let x = rest + self.u[i];
+            let c = project_node(rest + self.u_prev[i], x, &from, &to, friction, reach);
+            if c.moved {
+                self.u[i] = c.x - rest;
+                impulse += self.mass[i] * (c.x - x);
+                touched += 1;
+            }
+            self.near_edge[i] |= c.near_edge;
+        }
+        self.contact_impulse += impulse;
+        self.contact_nodes = touched;
     }
 
     /// `v += h g; u_prev = u; u += h v` for free nodes; kinematic nodes jump to their
@@ -522,14 +615,29 @@ impl Solver {
         let Some(threshold) = self.params.release_threshold else {
             return 0;
         };
+        let near_edge = matches!(self.params.cut_zone, CutZone::NearEdge { .. });
         let over: Vec<u32> = (0..self.von_mises.len())
             .filter(|&t| self.cut.is_live(t) && self.von_mises[t] > threshold)
+            .filter(|&t| {
+                !near_edge
+                    || self.mesh.tets[t]
+                        .iter()
+                        .any(|&i| self.near_edge[i as usize])
+            })
             .map(|t| t as u32)
             .collect();
         if over.is_empty() {
             return 0;
         }
         self.release(&over).tets.len()
+    }
+
+    /// Mean force the tissue exerted on the tool over the last frame, N: the contact
+    /// multipliers `f = Σ λ / h²` (PHYSICS.md §1.5), averaged over the substeps, with the
+    /// sign of the reaction on the tool.
+    pub fn tool_force(&self) -> Vec3 {
+        let h = self.params.substep();
+        -self.contact_impulse / (h * h * self.params.substeps as f32)
     }
 
     /// Frame statistics over the live tets (PHYSICS.md §1.3 stress, volume, energy).
@@ -570,6 +678,8 @@ impl Solver {
             retired_nodes: self.cut.retired_count(),
             volume_ratio: if rest > 0.0 { vol / rest } else { 0.0 },
             kinetic_energy: ke,
+            tool_force: self.tool_force(),
+            contact_nodes: self.contact_nodes,
             solve_ms: 0.0,
             stress_ms: 0.0,
         }
