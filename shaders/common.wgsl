@@ -14,6 +14,10 @@ struct Params {
     slot_count: u32,   // tets, in colour order
     grab_count: u32,
     mode: u32,         // 0: coupled H+D projection, 1: sequential H then D
+    sphere_count: u32, // tool spheres (0: no tool)
+    box_count: u32,    // tool boxes
+    friction: f32,     // tool friction coefficient
+    reach: f32,        // cut zone: release only near the edge, m; < 0: anywhere
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,

@@ -8,12 +8,21 @@
 @group(0) @binding(2) var<storage, read_write> live: array<u32>;
 @group(0) @binding(3) var<storage, read_write> released_count: atomic<u32>;
 @group(0) @binding(4) var<storage, read_write> released_list: array<u32>;
+@group(0) @binding(5) var<storage, read> tets: array<vec4<u32>>;
+@group(0) @binding(6) var<storage, read> near_edge: array<u32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let slot = gid.x;
     if (slot >= P.slot_count || P.threshold <= 0.0) {
         return;
+    }
+    // Cut zone (CutZone::NearEdge): only tets with a node the cutting edge came near.
+    if (P.reach >= 0.0) {
+        let t = tets[slot];
+        if (near_edge[t.x] + near_edge[t.y] + near_edge[t.z] + near_edge[t.w] == 0u) {
+            return;
+        }
     }
     if (live[slot] != 0u && von_mises[slot] > P.threshold) {
         live[slot] = 0u;

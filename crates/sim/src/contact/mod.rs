@@ -7,7 +7,7 @@ mod projection;
 mod sdf;
 mod tool;
 
-pub use projection::{NodeContact, project_node};
+pub use projection::{NodeContact, ON_SURFACE, project_node};
 pub use sdf::{PlacedTool, WorldBox, WorldSphere, box_distance, sphere_distance};
 pub use tool::{ContactTool, CutZone, ToolBox, ToolPose, ToolSphere};
 

@@ -6,6 +6,10 @@ use glam::Vec3;
 
 use super::sdf::{PlacedTool, WorldBox, WorldSphere, box_distance};
 
+/// Distance within which a node counts as lying on the tool's surface at the start of
+/// a substep (where the last projection left it, give or take rounding), m.
+pub const ON_SURFACE: f32 = 1e-6;
+
 /// What the contact did to one node in one substep.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NodeContact {
@@ -67,13 +71,21 @@ pub fn project_node(
 }
 
 /// Sphere contact, continuous in the sphere's frame: the relative path runs from
-/// `x_prev − c0` to `x − c1`.
+/// `a = x_prev − c0` to `b = x − c1`.
+///
+/// A node whose path enters the sphere during the substep goes back to the surface
+/// along the normal where it entered, even if it ended beyond the sphere (no
+/// tunnelling). A node that starts the substep on the surface (where the last substep
+/// left it, within [`ON_SURFACE`]) or inside stays where it sits on a cutting sphere
+/// (the edge bites: tissue does not flow round a blade's edge, it is stressed until the
+/// criterion releases it), and leaves a non-cutting sphere by the shortest way, so it
+/// slides round it with friction, unless that is past the centre from where it
+/// started. The tolerance makes the choice independent of rounding (CPU and GPU agree).
 fn push_out_of_sphere(x_prev: Vec3, x: Vec3, s0: &WorldSphere, s1: &WorldSphere) -> Vec3 {
     let r = s1.radius;
     let a = x_prev - s0.centre;
     let b = x - s1.centre;
-    let started_outside = a.length_squared() >= r * r;
-    let n = if started_outside {
+    let n = if a.length() > r + ON_SURFACE {
         // First time t ∈ [0, 1] with |a + t (b − a)| = r, if any.
         let e = b - a;
         let ee = e.length_squared();
@@ -88,23 +100,26 @@ fn push_out_of_sphere(x_prev: Vec3, x: Vec3, s0: &WorldSphere, s1: &WorldSphere)
         }
         (a + e * t).normalize_or(Vec3::Z)
     } else if b.length_squared() < r * r {
-        // Already inside when the substep began: out along the shortest way.
-        b.try_normalize()
-            .or_else(|| (x_prev - s1.centre).try_normalize())
-            .unwrap_or(Vec3::Z)
+        let start = a.try_normalize().unwrap_or(Vec3::Z);
+        match b.try_normalize() {
+            Some(nb) if !s1.cutting && nb.dot(start) > 0.0 => nb,
+            _ => start,
+        }
     } else {
         return x;
     };
     s1.centre + n * r
 }
 
-/// Box contact, continuous in the box's frame (slab test of the relative path).
+/// Box contact, continuous in the box's frame (slab test of the relative path): a node
+/// whose path enters the box goes back onto the face it came through; one that starts
+/// on a face (within [`ON_SURFACE`]) or inside goes out through the face nearest to
+/// where it was, unless it is already past that face.
 fn push_out_of_box(x_prev: Vec3, x: Vec3, b0: &WorldBox, b1: &WorldBox) -> Vec3 {
     let h = b1.half_extents;
     let l0 = b0.to_local(x_prev);
     let mut l1 = b1.to_local(x);
-    if box_distance(l0, h) >= 0.0 {
-        // Started outside: find where the path enters, if it does.
+    if box_distance(l0, h) > ON_SURFACE {
         let e = l1 - l0;
         let (mut t_in, mut t_out) = (f32::NEG_INFINITY, f32::INFINITY);
         let mut axis = 0;
@@ -128,24 +143,29 @@ fn push_out_of_box(x_prev: Vec3, x: Vec3, b0: &WorldBox, b1: &WorldBox) -> Vec3 
         if t_in > t_out || !(0.0..=1.0).contains(&t_in) {
             return x;
         }
-        // Back onto the face it came through.
         l1[axis] = if e[axis] > 0.0 { -h[axis] } else { h[axis] };
     } else {
-        let q = l1.abs() - h;
-        if q.max_element() >= 0.0 {
+        let (axis, side) = nearest_face(l0, h);
+        if l1[axis] * side >= h[axis] {
             return x;
         }
-        // Inside from the start: out through the nearest face.
-        let axis = if q.x >= q.y && q.x >= q.z {
-            0
-        } else if q.y >= q.z {
-            1
-        } else {
-            2
-        };
-        l1[axis] = if l1[axis] >= 0.0 { h[axis] } else { -h[axis] };
+        l1[axis] = side * h[axis];
     }
     b1.to_world(l1)
+}
+
+/// The face of a box (half extents `h`) nearest to the box-frame point `l`: axis and
+/// side (±1).
+fn nearest_face(l: Vec3, h: Vec3) -> (usize, f32) {
+    let q = l.abs() - h;
+    let axis = if q.x >= q.y && q.x >= q.z {
+        0
+    } else if q.y >= q.z {
+        1
+    } else {
+        2
+    };
+    (axis, if l[axis] >= 0.0 { 1.0 } else { -1.0 })
 }
 
 /// Positional Coulomb friction against the tool's own motion at the contact point.

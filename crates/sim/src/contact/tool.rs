@@ -141,14 +141,16 @@ impl ContactTool {
         self.spheres.iter().any(|s| s.cutting)
     }
 
-    /// The same tool with its cutting-edge spheres removed (a dull tool).
+    /// The same tool with a dull edge: the edge spheres still push, but none cuts.
     pub fn dulled(&self) -> ContactTool {
         ContactTool {
             spheres: self
                 .spheres
                 .iter()
-                .copied()
-                .filter(|s| !s.cutting)
+                .map(|s| ToolSphere {
+                    cutting: false,
+                    ..*s
+                })
                 .collect(),
             ..self.clone()
         }

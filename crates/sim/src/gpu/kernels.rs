@@ -1,7 +1,14 @@
 //! The WGSL kernels: sources (common.wgsl prepended to each stage) and compiled pipelines.
 
 /// The compute stages, in the order a frame runs them; each is `shaders/<name>.wgsl`.
-pub const SHADER_STAGES: [&str; 5] = ["predict", "neo_hookean", "velocity", "stress", "release"];
+pub const SHADER_STAGES: [&str; 6] = [
+    "predict",
+    "neo_hookean",
+    "contact",
+    "velocity",
+    "stress",
+    "release",
+];
 
 const COMMON: &str = include_str!("../../../../shaders/common.wgsl");
 
@@ -10,6 +17,7 @@ pub fn shader_source(stage: &str) -> Option<String> {
     let body = match stage {
         "predict" => include_str!("../../../../shaders/predict.wgsl"),
         "neo_hookean" => include_str!("../../../../shaders/neo_hookean.wgsl"),
+        "contact" => include_str!("../../../../shaders/contact.wgsl"),
         "velocity" => include_str!("../../../../shaders/velocity.wgsl"),
         "stress" => include_str!("../../../../shaders/stress.wgsl"),
         "release" => include_str!("../../../../shaders/release.wgsl"),
@@ -22,6 +30,7 @@ pub fn shader_source(stage: &str) -> Option<String> {
 pub(crate) struct Kernels {
     pub predict: wgpu::ComputePipeline,
     pub project: wgpu::ComputePipeline,
+    pub contact: wgpu::ComputePipeline,
     pub velocity: wgpu::ComputePipeline,
     pub stress: wgpu::ComputePipeline,
     pub release: wgpu::ComputePipeline,
@@ -48,6 +57,7 @@ impl Kernels {
         Kernels {
             predict: make("predict"),
             project: make("neo_hookean"),
+            contact: make("contact"),
             velocity: make("velocity"),
             stress: make("stress"),
             release: make("release"),

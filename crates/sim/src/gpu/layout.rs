@@ -2,7 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// `Params` (uniform, 64 bytes).
+/// `Params` (uniform, 80 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(crate) struct Params {
@@ -17,6 +17,10 @@ pub(crate) struct Params {
     pub slot_count: u32,
     pub grab_count: u32,
     pub mode: u32,
+    pub sphere_count: u32,
+    pub box_count: u32,
+    pub friction: f32,
+    pub reach: f32,
     pub pad: [u32; 3],
 }
 
@@ -57,7 +61,7 @@ mod tests {
 
     #[test]
     fn sizes_match_wgsl() {
-        assert_eq!(std::mem::size_of::<Params>(), 64);
+        assert_eq!(std::mem::size_of::<Params>(), 80);
         assert_eq!(std::mem::size_of::<Step>(), 16);
         assert_eq!(std::mem::size_of::<TetRest>(), 48);
     }

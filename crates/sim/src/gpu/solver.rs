@@ -12,6 +12,7 @@ use super::layout::{
 };
 use super::{GpuContext, GpuError};
 use crate::Solver;
+use crate::contact::{ContactTool, CutZone, PlacedTool, ToolPose};
 use crate::xpbd::{FrameStats, NodeKind, SolverError, TetProjection};
 
 const WG: u32 = 64;
@@ -44,6 +45,10 @@ struct Buffers {
     released_list: wgpu::Buffer,
     saved_pos: wgpu::Buffer,
     saved_vel: wgpu::Buffer,
+    rest_pos: wgpu::Buffer,
+    tool: wgpu::Buffer,
+    push: wgpu::Buffer,
+    near_edge: wgpu::Buffer,
 }
 
 /// Bind groups for every dispatch of a frame.
@@ -52,6 +57,8 @@ struct Bindings {
     predict_steps: Vec<wgpu::BindGroup>,
     project: wgpu::BindGroup,
     project_steps: Vec<wgpu::BindGroup>,
+    contact: wgpu::BindGroup,
+    contact_steps: Vec<wgpu::BindGroup>,
     velocity: wgpu::BindGroup,
     stress: wgpu::BindGroup,
     release: wgpu::BindGroup,
@@ -64,6 +71,8 @@ struct Readback {
     von_mises: wgpu::Buffer,
     det_f: wgpu::Buffer,
     released: wgpu::Buffer,
+    push: wgpu::Buffer,
+    near_edge: wgpu::Buffer,
 }
 
 struct Timestamps {
@@ -88,6 +97,8 @@ pub struct GpuSolver {
     timestamps: Option<Timestamps>,
     last_timing: Option<GpuTiming>,
     offsets: Vec<[f32; 4]>,
+    params: Params,
+    tool_words: Vec<[f32; 4]>,
 }
 
 fn storage(
@@ -185,24 +196,7 @@ impl GpuSolver {
             .map(|&t| host.rotation[t as usize].to_array())
             .collect();
         let p = &host.params;
-        let h = p.substep();
-        let params = Params {
-            gravity: p.gravity.to_array(),
-            h,
-            inv_h: 1.0 / h,
-            keep: (1.0 - p.damping * h).max(0.0),
-            gamma: host.lame.gamma(p.hydrostatic),
-            mu: host.lame.mu,
-            threshold: p.release_threshold.unwrap_or(0.0),
-            node_count: n as u32,
-            slot_count: slots as u32,
-            grab_count: host.grabs.len() as u32,
-            mode: match p.projection {
-                TetProjection::Coupled => 0,
-                TetProjection::Sequential => 1,
-            },
-            pad: [0; 3],
-        };
+        let params = params_of(&host);
         // Step records: one per substep (prediction), then one per colour.
         let substeps = p.substeps as usize;
         let colours = host.color_ranges.len();
@@ -283,6 +277,15 @@ impl GpuSolver {
             rotation: storage(&device, "rotation", bytemuck::cast_slice(&rot), none),
             released_count: storage(&device, "released count", &[0u8; 4], none),
             released_list: storage(&device, "released list", &vec![0u8; slots * 4], none),
+            rest_pos: storage(
+                &device,
+                "rest positions",
+                bytemuck::cast_slice(&vec4(&host.mesh.rest_positions)),
+                none,
+            ),
+            tool: storage(&device, "tool", &[0u8; 16], none),
+            push: storage(&device, "contact push", &vec![0u8; n * 16], none),
+            near_edge: storage(&device, "near edge", &vec![0u8; n * 4], none),
         };
         let b = &buf;
         let group =
@@ -334,6 +337,10 @@ impl GpuSolver {
             project_steps: (0..colours)
                 .map(|c| step_group(&kernels.project, substeps + c))
                 .collect(),
+            contact: contact_group(&device, &kernels, b),
+            contact_steps: (0..substeps)
+                .map(|s| step_group(&kernels.contact, s))
+                .collect(),
             velocity: group(
                 &kernels.velocity,
                 0,
@@ -364,6 +371,8 @@ impl GpuSolver {
                     &b.live,
                     &b.released_count,
                     &b.released_list,
+                    &b.tets,
+                    &b.near_edge,
                 ],
                 "release",
             ),
@@ -374,6 +383,8 @@ impl GpuSolver {
             von_mises: staging(&device, "read von mises", slots as u64 * 4),
             det_f: staging(&device, "read det F", slots as u64 * 4),
             released: staging(&device, "read released", 4 + slots as u64 * 4),
+            push: staging(&device, "read contact push", n as u64 * 16),
+            near_edge: staging(&device, "read near edge", n as u64 * 4),
         };
         let timestamps = ctx.timestamps.then(|| Timestamps {
             queries: device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -402,7 +413,24 @@ impl GpuSolver {
             read,
             timestamps,
             last_timing: None,
+            params,
+            tool_words: Vec::new(),
         })
+    }
+
+    /// Attach a tool at `pose` (see [`Solver::set_tool`]).
+    pub fn set_tool(&mut self, tool: ContactTool, pose: ToolPose) -> Result<(), SolverError> {
+        self.host.set_tool(tool, pose)
+    }
+
+    /// Where the tool will be at the end of the next frame (see [`Solver::move_tool`]).
+    pub fn move_tool(&mut self, to: ToolPose) {
+        self.host.move_tool(to);
+    }
+
+    /// Detach the tool.
+    pub fn remove_tool(&mut self) {
+        self.host.remove_tool();
     }
 
     /// The host mirror: mesh, cut state, positions, velocities, stress of the last frame.
@@ -438,6 +466,7 @@ impl GpuSolver {
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
         let t0 = Instant::now();
         self.upload_grab_offsets();
+        self.upload_tool();
         let mut enc = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -447,7 +476,16 @@ impl GpuSolver {
         enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.buf.saved_pos, 0, n * 16);
         enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.buf.saved_vel, 0, n * 16);
         enc.clear_buffer(&self.buf.released_count, 0, None);
+        let with_tool = self.host.tool.is_some();
+        if with_tool {
+            enc.clear_buffer(&self.buf.push, 0, None);
+            enc.clear_buffer(&self.buf.near_edge, 0, None);
+        }
         self.record_frame(&mut enc);
+        if with_tool {
+            enc.copy_buffer_to_buffer(&self.buf.push, 0, &self.read.push, 0, n * 16);
+            enc.copy_buffer_to_buffer(&self.buf.near_edge, 0, &self.read.near_edge, 0, n * 4);
+        }
         enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.read.pos, 0, n * 16);
         enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.read.vel, 0, n * 16);
         enc.copy_buffer_to_buffer(&self.buf.von_mises, 0, &self.read.von_mises, 0, slots * 4);
@@ -486,6 +524,9 @@ impl GpuSolver {
             .collect();
         let ev = self.host.release(&mesh_tets);
         self.retire_on_device(&ev.retired_nodes);
+        if let Some(m) = &mut self.host.tool {
+            m.from = m.to;
+        }
         let mut stats = self.host.stats(ev.tets.len());
         stats.solve_ms = solve_ms;
         stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
@@ -511,6 +552,31 @@ impl GpuSolver {
             0,
             bytemuck::cast_slice(&self.offsets),
         );
+    }
+
+    /// Parameters, primitive poses for every substep boundary and, when the tool's
+    /// primitive count changed, a larger tool buffer.
+    fn upload_tool(&mut self) {
+        let params = params_of(&self.host);
+        if let Some(motion) = &self.host.tool {
+            let n = self.host.params.substeps;
+            self.tool_words.clear();
+            for k in 0..=n {
+                push_placed(&mut self.tool_words, &motion.placed_at(k, n));
+            }
+            let bytes: &[u8] = bytemuck::cast_slice(&self.tool_words);
+            if bytes.len() as u64 > self.buf.tool.size() {
+                self.buf.tool = storage(&self.device, "tool", bytes, wgpu::BufferUsages::empty());
+                self.bind.contact = contact_group(&self.device, &self.kernels, &self.buf);
+            } else {
+                self.queue.write_buffer(&self.buf.tool, 0, bytes);
+            }
+        }
+        if bytemuck::bytes_of(&params) != bytemuck::bytes_of(&self.params) {
+            self.params = params;
+            self.queue
+                .write_buffer(&self.buf.params, 0, bytemuck::bytes_of(&self.params));
+        }
     }
 
     /// All dispatches of one frame in one compute pass.
@@ -540,6 +606,12 @@ impl GpuSolver {
                 pass.set_bind_group(1, &self.bind.project_steps[c], &[]);
                 pass.dispatch_workgroups(groups(r.len()), 1, 1);
             }
+            if self.host.tool.is_some() {
+                pass.set_pipeline(&k.contact);
+                pass.set_bind_group(0, &self.bind.contact, &[]);
+                pass.set_bind_group(1, &self.bind.contact_steps[s], &[]);
+                pass.dispatch_workgroups(groups(n), 1, 1);
+            }
             pass.set_pipeline(&k.velocity);
             pass.set_bind_group(0, &self.bind.velocity, &[]);
             pass.dispatch_workgroups(groups(n), 1, 1);
@@ -554,6 +626,7 @@ impl GpuSolver {
 
     /// Map the staging buffers, copy into the host mirror; returns released slots.
     fn read_back(&mut self) -> Result<Vec<u32>, GpuError> {
+        let with_tool = self.host.tool.is_some();
         let mut bufs = vec![
             &self.read.pos,
             &self.read.vel,
@@ -561,6 +634,10 @@ impl GpuSolver {
             &self.read.det_f,
             &self.read.released,
         ];
+        if with_tool {
+            bufs.push(&self.read.push);
+            bufs.push(&self.read.near_edge);
+        }
         if let Some(ts) = &self.timestamps {
             bufs.push(&ts.read);
         }
@@ -585,6 +662,22 @@ impl GpuSolver {
         let vm = view(&self.read.von_mises)?;
         let det = view(&self.read.det_f)?;
         let rel = view(&self.read.released)?;
+        if with_tool {
+            let push = view(&self.read.push)?;
+            let near = view(&self.read.near_edge)?;
+            let push: &[[f32; 4]] = bytemuck::cast_slice(&push);
+            let near: &[u32] = bytemuck::cast_slice(&near);
+            for (i, (p, e)) in push.iter().zip(near).enumerate() {
+                self.host.contact_push[i] = Vec3::new(p[0], p[1], p[2]);
+                self.host.near_edge[i] = *e != 0;
+            }
+        } else {
+            self.host
+                .contact_push
+                .iter_mut()
+                .for_each(|p| *p = Vec3::ZERO);
+            self.host.near_edge.iter_mut().for_each(|e| *e = false);
+        }
         if let Some(ts) = &self.timestamps {
             let t = view(&ts.read)?;
             let q: &[u64] = bytemuck::cast_slice(&t);
@@ -672,4 +765,80 @@ impl GpuSolver {
             );
         }
     }
+}
+
+/// The kernels' `Params` for the host's settings and tool (primitive counts and friction
+/// of the attached tool, if any).
+fn params_of(host: &Solver) -> Params {
+    let p = &host.params;
+    let h = p.substep();
+    let (sphere_count, box_count, friction) = host.tool.as_ref().map_or((0, 0, 0.0), |m| {
+        (
+            m.tool.spheres.len() as u32,
+            m.tool.boxes.len() as u32,
+            m.tool.friction,
+        )
+    });
+    Params {
+        gravity: p.gravity.to_array(),
+        h,
+        inv_h: 1.0 / h,
+        keep: (1.0 - p.damping * h).max(0.0),
+        gamma: host.lame.gamma(p.hydrostatic),
+        mu: host.lame.mu,
+        threshold: p.release_threshold.unwrap_or(0.0),
+        node_count: host.x.len() as u32,
+        slot_count: host.slots.len() as u32,
+        grab_count: host.grabs.len() as u32,
+        mode: match p.projection {
+            TetProjection::Coupled => 0,
+            TetProjection::Sequential => 1,
+        },
+        sphere_count,
+        box_count,
+        friction,
+        reach: match p.cut_zone {
+            CutZone::NearEdge { reach } => reach,
+            CutZone::Anywhere => -1.0,
+        },
+        pad: [0; 3],
+    }
+}
+
+/// Append one pose block of the `tool` buffer (layout in `shaders/contact.wgsl`).
+fn push_placed(words: &mut Vec<[f32; 4]>, placed: &PlacedTool) {
+    words.push([placed.lo.x, placed.lo.y, placed.lo.z, 0.0]);
+    words.push([placed.hi.x, placed.hi.y, placed.hi.z, 0.0]);
+    for s in &placed.spheres {
+        let r = if s.cutting { s.radius } else { -s.radius };
+        words.push([s.centre.x, s.centre.y, s.centre.z, r]);
+    }
+    for b in &placed.boxes {
+        words.push([b.centre.x, b.centre.y, b.centre.z, 0.0]);
+        for (a, h) in [
+            (b.axes.x_axis, b.half_extents.x),
+            (b.axes.y_axis, b.half_extents.y),
+            (b.axes.z_axis, b.half_extents.z),
+        ] {
+            words.push([a.x, a.y, a.z, h]);
+        }
+    }
+}
+
+/// The contact kernel's bind group (rebuilt when the tool buffer grows).
+fn contact_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("contact"),
+        layout: &kernels.contact.get_bind_group_layout(0),
+        entries: &entries(&[
+            &b.params,
+            &b.pos,
+            &b.prev,
+            &b.kind,
+            &b.rest_pos,
+            &b.tool,
+            &b.push,
+            &b.near_edge,
+        ]),
+    })
 }

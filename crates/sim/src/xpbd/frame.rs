@@ -28,7 +28,7 @@ pub struct FrameStats {
     pub kinetic_energy: f64,
     /// Mean force the tissue exerted on the tool this frame (x, y, z), N.
     pub tool_force: Vec3,
-    /// Nodes in contact with the tool at the frame's last substep.
+    /// Nodes the tool pushed during the frame.
     pub contact_nodes: usize,
     /// Wall time of the substeps (prediction, projection, velocity update), ms.
     pub solve_ms: f64,

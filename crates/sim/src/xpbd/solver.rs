@@ -75,10 +75,8 @@ pub struct Solver {
     pub(crate) tool: Option<ToolMotion>,
     /// Nodes that came within the cut reach of a cutting sphere this frame.
     pub(crate) near_edge: Vec<bool>,
-    /// Σ m Δx of the contact projections this frame (tissue side), kg·m.
-    pub(crate) contact_impulse: Vec3,
-    /// Nodes the tool moved in the frame's last substep.
-    pub(crate) contact_nodes: usize,
+    /// Per node, Σ m Δx of the contact projections this frame (tissue side), kg·m.
+    pub(crate) contact_push: Vec<Vec3>,
     pub(crate) frame: u64,
     pub(crate) time: f64,
     pub(crate) pool: Option<rayon::ThreadPool>,
@@ -163,8 +161,7 @@ impl Solver {
             cut: CutState::new(&mesh),
             tool: None,
             near_edge: vec![false; n],
-            contact_impulse: Vec3::ZERO,
-            contact_nodes: 0,
+            contact_push: vec![Vec3::ZERO; n],
             frame: 0,
             time: 0.0,
             pool,
@@ -351,8 +348,7 @@ impl Solver {
         let saved = (self.u.clone(), self.v.clone());
         let t0 = Instant::now();
         self.near_edge.iter_mut().for_each(|b| *b = false);
-        self.contact_impulse = Vec3::ZERO;
-        self.contact_nodes = 0;
+        self.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
         match self.pool.take() {
             Some(pool) => {
                 pool.install(|| self.run_substeps(true));
@@ -421,8 +417,6 @@ impl Solver {
             CutZone::NearEdge { reach } => Some(reach),
             CutZone::Anywhere => None,
         };
-        let mut impulse = Vec3::ZERO;
-        let mut touched = 0;
         for i in 0..self.u.len() {
             if self.kind[i] != NodeKind::Free {
                 continue;
@@ -432,13 +426,10 @@ impl Solver {
             let c = project_node(rest + self.u_prev[i], x, &from, &to, friction, reach);
             if c.moved {
                 self.u[i] = c.x - rest;
-                impulse += self.mass[i] * (c.x - x);
-                touched += 1;
+                self.contact_push[i] += self.mass[i] * (c.x - x);
             }
             self.near_edge[i] |= c.near_edge;
         }
-        self.contact_impulse += impulse;
-        self.contact_nodes = touched;
     }
 
     /// `v += h g; u_prev = u; u += h v` for free nodes; kinematic nodes jump to their
@@ -637,7 +628,8 @@ impl Solver {
     /// sign of the reaction on the tool.
     pub fn tool_force(&self) -> Vec3 {
         let h = self.params.substep();
-        -self.contact_impulse / (h * h * self.params.substeps as f32)
+        let push: Vec3 = self.contact_push.iter().sum();
+        -push / (h * h * self.params.substeps as f32)
     }
 
     /// Frame statistics over the live tets (PHYSICS.md §1.3 stress, volume, energy).
@@ -679,7 +671,11 @@ impl Solver {
             volume_ratio: if rest > 0.0 { vol / rest } else { 0.0 },
             kinetic_energy: ke,
             tool_force: self.tool_force(),
-            contact_nodes: self.contact_nodes,
+            contact_nodes: self
+                .contact_push
+                .iter()
+                .filter(|p| **p != Vec3::ZERO)
+                .count(),
             solve_ms: 0.0,
             stress_ms: 0.0,
         }

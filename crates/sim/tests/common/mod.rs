@@ -137,3 +137,87 @@ pub fn tearing_bar(threads: usize) -> Solver {
     });
     s
 }
+
+/// A blade in the tool's x–z plane: `count` cutting spheres of radius `r`, `spacing`
+/// apart along x from the origin (the edge is their lower envelope), and a 0.4 mm thick
+/// non-cutting flat above them, friction 0.2.
+pub fn blade(count: usize, r: f32, spacing: f32) -> incise_sim::contact::ContactTool {
+    use incise_sim::contact::{ContactTool, ToolBox, ToolSphere};
+    let length = spacing * (count - 1) as f32;
+    ContactTool {
+        spheres: (0..count)
+            .map(|i| ToolSphere {
+                centre: Vec3::new(i as f32 * spacing, 0.0, 0.0),
+                radius: r,
+                cutting: true,
+            })
+            .collect(),
+        boxes: vec![ToolBox {
+            centre: Vec3::new(length / 2.0, 0.0, r + 0.01),
+            rotation: glam::Quat::IDENTITY,
+            half_extents: Vec3::new(length / 2.0 + r, 0.0002, 0.01),
+        }],
+        friction: 0.2,
+    }
+}
+
+/// Top of the incision block, m.
+pub const INCISION_TOP: f32 = 0.02;
+/// Blade depth of the scripted incision below the top, m.
+pub const INCISION_DEPTH: f32 = 0.006;
+
+/// A 6 × 3 × 2 cm soft block (E = 10 kPa, ν = 0.45, no gravity, release at 3 kPa near the
+/// edge), bottom pinned, and an 8-sphere blade (r = half the mean edge length) 2 mm
+/// above its top. Returns the solver (tool attached), the sphere radius and the blade's
+/// path: down to [`INCISION_DEPTH`], then 3 cm along x (the blade spans 1.1 cm ahead of
+/// its origin, so its front stops 9 mm before the block's end).
+pub fn incision_block(
+    threads: usize,
+    tool: Option<incise_sim::contact::ContactTool>,
+) -> (Solver, f32, Vec<Vec3>) {
+    use incise_sim::contact::{CutZone, ToolPose};
+    use incise_sim::selection::NodeSelection;
+    let mesh = block_mesh(
+        Vec3::ZERO,
+        Vec3::new(0.06, 0.03, INCISION_TOP),
+        UVec3::new(24, 12, 8),
+    );
+    let edge = mesh.mean_edge_length();
+    let params = SolverParams {
+        gravity: Vec3::ZERO,
+        damping: 10.0,
+        threads,
+        release_threshold: Some(3e3),
+        cut_zone: CutZone::NearEdge { reach: 0.25 * edge },
+        ..SolverParams::default()
+    };
+    let mut s = solver(mesh, soft(10e3, 0.45), params);
+    let rest = s.mesh().rest_positions.clone();
+    let bottom = NodeSelection::PlaneSide {
+        point: Vec3::new(0.0, 0.0, 1e-4),
+        normal: -Vec3::Z,
+    };
+    s.pin(&bottom.select(&rest).expect("bottom face"));
+    let r = 0.5 * edge;
+    let start = Vec3::new(0.01, 0.015, INCISION_TOP + r + 0.002);
+    let down = start - Vec3::Z * (INCISION_DEPTH + 0.002);
+    let end = down + Vec3::X * 0.03;
+    let tool = tool.unwrap_or_else(|| blade(8, r, r));
+    s.set_tool(tool, ToolPose::new(start, glam::Quat::IDENTITY))
+        .expect("valid tool");
+    (s, r, vec![start, down, end])
+}
+
+/// Frame-by-frame targets of a tool moving through `path` at `speed`, holding `hold`
+/// frames at each waypoint.
+pub fn tool_targets(path: &[Vec3], speed: f32, dt: f32, hold: usize) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    for w in path.windows(2) {
+        let frames = ((w[1] - w[0]).length() / (speed * dt)).ceil().max(1.0) as usize;
+        for f in 1..=frames {
+            out.push(w[0].lerp(w[1], f as f32 / frames as f32));
+        }
+        out.extend(std::iter::repeat_n(w[1], hold));
+    }
+    out
+}
