@@ -1,0 +1,40 @@
+//! incise-scalpel: the scalpel as data — tool models read from RON files.
+//!
+//! The crate has no GPU, window or XR code: it turns files into the plain
+//! [`incise_sim::contact::ContactTool`] the solver consumes (PHYSICS.md §1.5) and a
+//! triangle mesh the renderer draws.
+//!
+//! # Units
+//! Tool files (`config/tools/*.ron`) give lengths in **millimetres**, as blade drawings
+//! do. Everything else — [`Tool`], [`ContactTool`](incise_sim::contact::ContactTool),
+//! render meshes — is SI: metres, seconds, newtons.
+//!
+//! # Tool frame
+//! Right-handed, fixed to the blade:
+//! - origin at the blade **tip**;
+//! - **+x** along the spine, from the tip toward the handle;
+//! - **+z** from the cutting edge toward the spine (blade "up");
+//! - **+y** the blade normal (thickness direction); the blade's mid-plane is `y = 0`.
+//!
+//! The blade outline and the cutting edge are drawn in the x–z plane; the cutting edge is
+//! the blade's lower outline. A [`ToolPose`](incise_sim::contact::ToolPose) places this
+//! frame in the world, so a stroke's `position` is where the blade tip is.
+//!
+//! # Contact model
+//! [`Tool::contact_tool`] puts cutting spheres evenly (by arc length) along the edge, each
+//! centred one radius inside the blade along the edge's in-plane normal, so every sphere
+//! is tangent to the edge line from inside and the blade never pushes tissue beyond its
+//! real edge. The coarse body (blade flat and handle) is a list of boxes that push but
+//! never cut.
+
+mod error;
+mod render_mesh;
+mod ron_text;
+mod tool;
+mod tool_body;
+mod tool_spec;
+mod triangulate;
+
+pub use error::{FieldError, FileError};
+pub use tool::{Handle, MAX_EDGE_SPHERES, Tool, load_tool, parse_tool};
+pub use tool_spec::{BodyBoxSpec, DEFAULT_FRICTION, HandleSpec, SpherePlacement, ToolSpec};
