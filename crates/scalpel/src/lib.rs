@@ -1,13 +1,14 @@
-//! incise-scalpel: the scalpel as data — tool models read from RON files.
+//! incise-scalpel: the scalpel as data — tool models read from RON files and strokes
+//! (timed tool poses, scripted or recorded).
 //!
 //! The crate has no GPU, window or XR code: it turns files into the plain
-//! [`incise_sim::contact::ContactTool`] the solver consumes (PHYSICS.md §1.5) and a
-//! triangle mesh the renderer draws.
+//! [`incise_sim::contact::ContactTool`] and [`incise_sim::contact::ToolPose`] values the
+//! solver consumes (PHYSICS.md §1.5) and a triangle mesh the renderer draws.
 //!
 //! # Units
 //! Tool files (`config/tools/*.ron`) give lengths in **millimetres**, as blade drawings
 //! do. Everything else — [`Tool`], [`ContactTool`](incise_sim::contact::ContactTool),
-//! render meshes — is SI: metres, seconds, newtons.
+//! strokes, render meshes — is SI: metres, seconds, newtons.
 //!
 //! # Tool frame
 //! Right-handed, fixed to the blade:
@@ -28,13 +29,20 @@
 //! never cut.
 
 mod error;
+mod incision;
+mod interpolate;
+mod recorder;
 mod render_mesh;
 mod ron_text;
+mod stroke;
 mod tool;
 mod tool_body;
 mod tool_spec;
 mod triangulate;
 
 pub use error::{FieldError, FileError};
+pub use incision::Incision;
+pub use recorder::StrokeRecorder;
+pub use stroke::{PoseKey, Stroke, load_stroke, parse_stroke};
 pub use tool::{Handle, MAX_EDGE_SPHERES, Tool, load_tool, parse_tool};
 pub use tool_spec::{BodyBoxSpec, DEFAULT_FRICTION, HandleSpec, SpherePlacement, ToolSpec};
