@@ -1,9 +1,10 @@
-//! incise-scalpel: the scalpel as data — tool models read from RON files and strokes
-//! (timed tool poses, scripted or recorded).
+//! incise-scalpel: the scalpel as data — tool models read from RON files, strokes (timed
+//! tool poses, scripted or recorded) and the contact-force → vibration curve.
 //!
 //! The crate has no GPU, window or XR code: it turns files into the plain
 //! [`incise_sim::contact::ContactTool`] and [`incise_sim::contact::ToolPose`] values the
-//! solver consumes (PHYSICS.md §1.5) and a triangle mesh the renderer draws.
+//! solver consumes (PHYSICS.md §1.5), a triangle mesh the renderer draws, and a vibration
+//! amplitude a controller plays.
 //!
 //! # Units
 //! Tool files (`config/tools/*.ron`) give lengths in **millimetres**, as blade drawings
@@ -29,6 +30,7 @@
 //! never cut.
 
 mod error;
+mod haptic;
 mod incision;
 mod interpolate;
 mod recorder;
@@ -41,6 +43,7 @@ mod tool_spec;
 mod triangulate;
 
 pub use error::{FieldError, FileError};
+pub use haptic::HapticCurve;
 pub use incision::Incision;
 pub use recorder::StrokeRecorder;
 pub use stroke::{PoseKey, Stroke, load_stroke, parse_stroke};
