@@ -117,7 +117,8 @@ impl Incision {
         let mut t = 0.0f64;
         for leg in corners.windows(2) {
             let (a, b) = (leg[0], leg[1]);
-            let len = (b - a).length() as f64;
+            let (a64, b64) = (a.as_dvec3(), b.as_dvec3());
+            let len = (b64 - a64).length();
             if len == 0.0 {
                 continue;
             }
@@ -129,7 +130,7 @@ impl Incision {
                 let position = if k == n {
                     b
                 } else {
-                    a.lerp(b, k as f32 / n as f32)
+                    a64.lerp(b64, k as f64 / n as f64).as_vec3()
                 };
                 keys.push(PoseKey {
                     t,

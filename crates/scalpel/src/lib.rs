@@ -29,6 +29,8 @@
 //! real edge. The coarse body (blade flat and handle) is a list of boxes that push but
 //! never cut.
 
+#![warn(missing_docs)]
+
 mod error;
 mod haptic;
 mod incision;
