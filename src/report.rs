@@ -40,14 +40,13 @@ pub struct EdgeFrameStats {
     pub frame: u64,
     /// Simulation time at the end of the frame, s.
     pub sim_time: f64,
-    /// Integration steps taken in the frame.
+    /// Integration steps taken in the frame (haptic-rate runs: haptic loops).
     pub substeps: u64,
     /// Current volume of the tets over their reference volume.
     pub volume_ratio: f64,
     /// Largest node displacement from the reference position, m.
     pub max_displacement: f64,
-    /// Kinetic energy ½ Σ m v², J (absent where the run cannot read the velocities, as in
-    /// a haptic-rate run whose thread owns the model).
+    /// Kinetic energy ½ Σ m v², J (haptic-rate runs: at the thread's last snapshot).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub kinetic_energy: Option<f64>,
     /// Wall time of the integration, ms (absent in a haptic-rate run, whose integration
@@ -191,6 +190,8 @@ pub struct HapticInfo {
     pub snapshots: u64,
     /// Report-loop rate, Hz (1 / the scene's frame_dt).
     pub report_hz: f64,
+    /// Blade advances the haptic thread cut.
+    pub cut_advances: u64,
     /// Tool force at the last frame (x, y, z), N.
     pub last_tool_force: [f64; 3],
     /// Largest tool force magnitude seen by the report loop, N.

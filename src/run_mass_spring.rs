@@ -5,9 +5,9 @@
 //!
 //! With `--haptic-rate HZ` the localised loop runs on its own thread at that rate
 //! (PHYSICS.md §2.6, [`HapticLoop`]), its tool tip at the middle of the scene's blade
-//! edge, while this thread runs the report loop in real time at the scene's frame rate
-//! and records the tool force the haptic thread publishes. The blade does not cut in that
-//! mode (the haptic thread owns the model).
+//! edge, and cuts along the stroke in that thread, while this thread runs the report loop
+//! in real time at the scene's frame rate and records the tool force, loop count and
+//! snapshot figures the haptic thread publishes.
 
 use std::path::Path;
 use std::time::Instant;
@@ -119,13 +119,8 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
                     opts.scene.display()
                 )
             })?;
-            if !opts.quiet {
-                eprintln!(
-                    "note: haptic-rate run: the tool follows the blade stroke in real time; \
-                     the blade does not cut in this mode"
-                );
-            }
-            let (model, haptic) = run_haptic(model, stroke, rate, frame_dt, frames, &mut report)?;
+            let (model, haptic) =
+                run_haptic(model, ms, stroke, rate, frame_dt, frames, &mut report)?;
             report.haptic = Some(haptic);
             model
         }
@@ -221,34 +216,31 @@ fn run_frames(
 }
 
 /// The haptic-rate run: the local loop on its own thread at `rate` Hz with its tool at
-/// the middle of the blade edge; this thread wakes every `frame_dt` of wall time for
-/// `frames` frames, moves the tool and records what the haptic thread published. Returns
-/// the model and the measured loop figures.
+/// the middle of the blade edge, cutting along the stroke; this thread wakes every
+/// `frame_dt` of wall time for `frames` frames, moves the tool and the blade to where the
+/// stroke is at the haptic thread's simulated time, and records what that thread
+/// published. Returns the model and the measured loop figures.
 fn run_haptic(
     model: MassSpringModel,
+    ms: &MassSpringScene,
     stroke: &StrokeSpec,
     rate: f64,
     frame_dt: f64,
     frames: u64,
     report: &mut Report,
 ) -> Result<(MassSpringModel, HapticInfo)> {
-    let tets = model.tets().to_vec();
-    let reference = model.reference_positions().to_vec();
-    let reference_volume = volume(&tets, &reference);
-    let tool = |t: f64| {
-        let (pose, _) = blade_at(stroke, t);
-        (pose.heel + pose.tip) * 0.5
-    };
+    let tool = |pose: BladePose| (pose.heel + pose.tip) * 0.5;
     let config = HapticConfig {
         rate_hz: rate,
         publish_hz: 1.0 / frame_dt,
         local: LocalLoopParams::default(),
+        cut: ms.cut.clone(),
         ..HapticConfig::default()
     };
     let start = Instant::now();
     let haptic = HapticLoop::spawn(model, config);
-    haptic.set_tool(Some(tool(0.0)));
-    let (mut previous_loops, mut max_force) = (0u64, 0.0f64);
+    haptic.set_tool(Some(tool(blade_at(stroke, 0.0).0)));
+    let (mut previous_loops, mut max_force, mut blade_down) = (0u64, 0.0f64, false);
     for f in 0..frames {
         let deadline = start + std::time::Duration::from_secs_f64((f + 1) as f64 * frame_dt);
         let now = Instant::now();
@@ -257,22 +249,34 @@ fn run_haptic(
         }
         let t0 = Instant::now();
         let latest = haptic.latest();
-        haptic.set_tool(Some(tool(latest.sim_time)));
+        let (pose, progress) = blade_at(stroke, latest.sim_time);
+        haptic.set_tool(Some(tool(pose)));
+        // The stroke's first pose places the blade; later ones cut; its end lifts it.
+        if progress > 0.0 && progress < 1.0 {
+            let pose = if blade_down {
+                pose
+            } else {
+                blade_at(stroke, stroke.start as f64).0
+            };
+            haptic.set_blade(Some(pose));
+            blade_down = true;
+        } else if blade_down && progress >= 1.0 {
+            haptic.set_blade(Some(pose));
+            blade_down = false;
+        } else {
+            haptic.set_blade(None);
+        }
         let force = latest.tool_force;
         max_force = max_force.max(force.length());
-        let positions = if latest.positions.is_empty() {
-            &reference
-        } else {
-            &latest.positions
-        };
         report.frames.push(FrameRecord {
             stats: FrameData::Edges(EdgeFrameStats {
                 frame: f,
                 sim_time: latest.sim_time,
                 substeps: latest.loops - previous_loops,
-                volume_ratio: volume(&tets, positions) / reference_volume,
-                max_displacement: max_displacement(&reference, positions),
-                kinetic_energy: None,
+                volume_ratio: latest.volume_ratio,
+                max_displacement: latest.max_displacement,
+                kinetic_energy: Some(latest.kinetic_energy),
+                solve_ms: None,
                 tool_force: Some(force.to_array()),
                 haptic_loops: Some(latest.loops),
                 ..EdgeFrameStats::default()
@@ -296,6 +300,7 @@ fn run_haptic(
         sim_time: last.sim_time,
         snapshots: last.snapshots,
         report_hz: 1.0 / frame_dt,
+        cut_advances: last.cut_advances,
         last_tool_force: last.tool_force.to_array(),
         max_tool_force: max_force.max(last.tool_force.length()),
     };
@@ -303,16 +308,6 @@ fn run_haptic(
         bail!("the haptic loop produced a non-finite rate or tool force: {info:?}");
     }
     Ok((model, info))
-}
-
-/// Volume of `tets` at positions `x`, m³.
-fn volume(tets: &[[u32; 4]], x: &[DVec3]) -> f64 {
-    tets.iter()
-        .map(|t| {
-            let [a, b, c, d] = t.map(|i| x[i as usize]);
-            (b - a).cross(c - a).dot(d - a) / 6.0
-        })
-        .sum()
 }
 
 /// Largest distance of a node from its reference position, m.

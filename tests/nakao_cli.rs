@@ -69,14 +69,14 @@ fn shipped_nakao_scene_cuts_and_reports() {
 #[test]
 fn haptic_rate_loop_runs_beside_the_report_loop() {
     let out = temp_dir("haptic");
-    // 40 report frames of 10 ms: 0.4 s of wall time with the 1 kHz loop beside them.
+    // 60 report frames of 10 ms: 0.6 s of wall time with the 1 kHz loop beside them.
     let o = incise(&[
         "run",
         "config/plate_cut_nakao.ron",
         "--haptic-rate",
         "1000",
         "--frames",
-        "40",
+        "60",
         "--vtu-every",
         "0",
         "--quiet",
@@ -98,7 +98,7 @@ fn haptic_rate_loop_runs_beside_the_report_loop() {
     let rate = h["achieved_hz"].as_f64().unwrap();
     assert_eq!(h["requested_hz"], 1000.0);
     assert!(loops > 0, "the haptic thread ran no loop");
-    assert!(wall >= 0.4, "the report loop ran in real time: {wall} s");
+    assert!(wall >= 0.6, "the report loop ran in real time: {wall} s");
     // The rate reported is the one measured: loops over wall time.
     assert!((rate - loops as f64 / wall).abs() < 1e-6 * rate, "{h}");
     // The loop sleeps to its period, so it cannot run much faster than asked (loose bound:
@@ -115,7 +115,7 @@ fn haptic_rate_loop_runs_beside_the_report_loop() {
         .collect();
     assert!(force.iter().all(|f| f.is_finite()), "{force:?}");
     let frames = report["frames"].as_array().unwrap();
-    assert_eq!(frames.len(), 40);
+    assert_eq!(frames.len(), 60);
     // Each frame carries the published force and a loop count that never decreases.
     let counts: Vec<u64> = frames
         .iter()
@@ -130,6 +130,14 @@ fn haptic_rate_loop_runs_beside_the_report_loop() {
     // The tool sits on the plate's top surface at the blade's edge: the virtual spring
     // to the nearest node pulls, so some frame records a non-zero force.
     assert!(h["max_tool_force"].as_f64().unwrap() > 0.0, "{h}");
+    // The blade starts at 0.2 s of simulated time; once the haptic thread has simulated
+    // 0.1 s beyond that (not guaranteed on a loaded machine) it has cut the plate.
+    let cuts = h["cut_advances"].as_u64().unwrap();
+    let nodes = report["mesh"]["nodes"].as_u64().unwrap();
+    eprintln!("haptic: {loops} loops in {wall:.3} s, sim {sim:.3} s, {cuts} cuts, {nodes} nodes");
+    if sim >= 0.3 {
+        assert!(cuts > 0 && nodes > 1_250, "{h}, {nodes} nodes");
+    }
 }
 
 #[test]
