@@ -48,6 +48,11 @@ pub enum Command {
         /// Size of those screenshots, WIDTHxHEIGHT.
         #[arg(long, default_value = "960x540")]
         screenshot_size: ImageSize,
+        /// Mass-spring scenes: run the localised loop on its own thread at this rate, Hz
+        /// (e.g. 1000 for a haptic device), with the tool on the scene's blade stroke; the
+        /// report loop runs at the scene's frame rate in real time.
+        #[arg(long, value_parser = positive_rate)]
+        haptic_rate: Option<f64>,
     },
     /// Open the desktop preview: the scene in a window with a control panel.
     Preview {
@@ -223,4 +228,16 @@ pub enum BenchCase {
     Plate,
     /// The 34k-tet intestine.
     Intestine,
+}
+
+/// A loop rate in Hz: finite, above 0 and at most 100 kHz.
+fn positive_rate(s: &str) -> Result<f64, String> {
+    let hz: f64 = s
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of Hz"))?;
+    if hz.is_finite() && hz > 0.0 && hz <= 100_000.0 {
+        Ok(hz)
+    } else {
+        Err(format!("must be a rate in (0, 100000] Hz, got {s}"))
+    }
 }

@@ -14,5 +14,6 @@ pub mod progress;
 pub mod report;
 pub mod run;
 pub mod run_mass_spring;
+pub mod run_rheology;
 pub mod scene;
 pub mod screenshots;

@@ -37,6 +37,7 @@ fn default_command() -> Command {
                 device: incise::body::DeviceChoice::Auto,
                 screenshot_every: 0,
                 screenshot_size: ImageSize(960, 540),
+                haptic_rate: None,
             }
         }
     }
@@ -56,6 +57,7 @@ fn main() -> ExitCode {
             device,
             screenshot_every,
             screenshot_size,
+            haptic_rate,
         } => run_scene(&RunOptions {
             scene,
             frames,
@@ -66,16 +68,10 @@ fn main() -> ExitCode {
             device,
             screenshot_every,
             screenshot_size,
+            haptic_rate,
         })
         .map(|o| {
-            let last = o.report.frames.last();
-            println!(
-                "completed {} frames of {}: {} tets released, max von Mises {:.0} Pa",
-                o.report.frames.len(),
-                o.report.scene,
-                last.map_or(0, |f| f.stats.released_total),
-                last.map_or(0.0, |f| f.stats.max_von_mises),
-            );
+            println!("{}", o.report.summary());
             println!("report: {}", o.report_path.display());
         }),
         Command::Preview {

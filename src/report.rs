@@ -1,4 +1,8 @@
 //! report.json: what a run did, frame by frame, in a form scripts can compare.
+//!
+//! Each model reports the quantities it computes: the XPBD solver its stresses and
+//! releases, the edge models (mass-spring, rheology) displacement, volume and energy. A
+//! quantity a model does not compute is left out, never written as NaN or null.
 
 use std::path::Path;
 
@@ -9,14 +13,59 @@ use serde::Serialize;
 /// One frame's line in the report.
 #[derive(Debug, Clone, Serialize)]
 pub struct FrameRecord {
-    /// Solver statistics.
+    /// The model's statistics.
     #[serde(flatten)]
-    pub stats: FrameStats,
+    pub stats: FrameData,
     /// Wall time of the frame (substeps + stress + release), ms.
     pub wall_ms: f64,
     /// GPU kernel time of the frame (timestamps), ms; absent on the CPU or without them.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gpu_ms: Option<f64>,
+}
+
+/// A frame's statistics, by model (written flat into the frame's record).
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum FrameData {
+    /// The XPBD Neo-Hookean solver: stresses, releases, contact.
+    Xpbd(FrameStats),
+    /// A model over tet edges (mass-spring or three-element rheology): no stress tensor.
+    Edges(EdgeFrameStats),
+}
+
+/// What one frame of an edge model (mass-spring, rheology) did.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct EdgeFrameStats {
+    /// Frame index (0-based).
+    pub frame: u64,
+    /// Simulation time at the end of the frame, s.
+    pub sim_time: f64,
+    /// Integration steps taken in the frame (haptic-rate runs: haptic loops).
+    pub substeps: u64,
+    /// Current volume of the tets over their reference volume.
+    pub volume_ratio: f64,
+    /// Largest node displacement from the reference position, m.
+    pub max_displacement: f64,
+    /// Kinetic energy ½ Σ m v², J (haptic-rate runs: at the thread's last snapshot).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kinetic_energy: Option<f64>,
+    /// Wall time of the integration, ms (absent in a haptic-rate run, whose integration
+    /// runs on the haptic thread).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub solve_ms: Option<f64>,
+    /// Latest force of the tissue on the haptic tool (x, y, z), N; haptic-rate runs only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tool_force: Option<[f64; 3]>,
+    /// Haptic loops run so far; haptic-rate runs only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub haptic_loops: Option<u64>,
+    /// Depth of the indenter face below the rest top, m; rheology scenes with an indenter.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub indenter_depth: Option<f64>,
+    /// Depth of the probe node (top node under the indenter's centre) below its rest
+    /// height, m; rheology scenes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dent_depth: Option<f64>,
 }
 
 /// The whole run report.
@@ -26,14 +75,17 @@ pub struct Report {
     pub scene: String,
     /// Scene file.
     pub scene_file: String,
+    /// Simulation model: "xpbd", "mass-spring" or "rheology".
+    pub model: String,
     /// "completed" or "failed".
     pub status: String,
     /// The error that stopped the run, if any.
     pub error: Option<String>,
     /// Mesh figures.
     pub mesh: MeshInfo,
-    /// Material name and values.
-    pub material: MaterialInfo,
+    /// Material name and values (absent for rheology scenes: see `rheology`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub material: Option<MaterialInfo>,
     /// Solver settings in use.
     pub solver: incise_sim::SolverParams,
     /// Worker threads used.
@@ -44,6 +96,12 @@ pub struct Report {
     pub frames: Vec<FrameRecord>,
     /// Snapshot files written (relative to the report).
     pub snapshots: Vec<String>,
+    /// Materials per region and dent figures of a rheology scene.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rheology: Option<RheologyInfo>,
+    /// Loop rate and tool force of a haptic-rate run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub haptic: Option<HapticInfo>,
 }
 
 /// Mesh figures for the report.
@@ -83,11 +141,107 @@ pub struct MaterialInfo {
     pub lambda: f32,
 }
 
+/// One material of a rheology scene and how much of the mesh takes it.
+#[derive(Debug, Clone, Serialize)]
+pub struct RegionMaterialInfo {
+    /// "default" or `regions[i]`.
+    pub region: String,
+    /// Preset name in the preset file.
+    pub preset: String,
+    /// Tets that take it (a later region wins over an earlier one).
+    pub tets: usize,
+    /// Edges that take it.
+    pub edges: usize,
+}
+
+/// Rheology-specific figures (PHYSICS.md §3).
+#[derive(Debug, Clone, Serialize)]
+pub struct RheologyInfo {
+    /// The preset file used.
+    pub presets_file: String,
+    /// Default material, then each region.
+    pub materials: Vec<RegionMaterialInfo>,
+    /// Explicit RK4 stability limit, s.
+    pub stability_limit_s: f64,
+    /// RK4 step used, s.
+    pub step_s: f64,
+    /// Largest probe depth over the run, m.
+    pub max_dent_m: f64,
+    /// Probe depth at the end of the run, m.
+    pub residual_dent_m: f64,
+}
+
+/// What the haptic-rate loop did (PHYSICS.md §2.6), all measured, none assumed.
+#[derive(Debug, Clone, Serialize)]
+pub struct HapticInfo {
+    /// Loop rate asked for, Hz.
+    pub requested_hz: f64,
+    /// Loops counted by the haptic thread over `wall_s`.
+    pub loops: u64,
+    /// Wall time from starting the thread to the last reading of its loop count, s.
+    pub wall_s: f64,
+    /// `loops / wall_s`, Hz.
+    pub achieved_hz: f64,
+    /// Loops that overran their period.
+    pub overruns: u64,
+    /// Simulated time the haptic thread reached, s.
+    pub sim_time: f64,
+    /// Position snapshots it published for the report loop.
+    pub snapshots: u64,
+    /// Report-loop rate, Hz (1 / the scene's frame_dt).
+    pub report_hz: f64,
+    /// Blade advances the haptic thread cut.
+    pub cut_advances: u64,
+    /// Tool force at the last frame (x, y, z), N.
+    pub last_tool_force: [f64; 3],
+    /// Largest tool force magnitude seen by the report loop, N.
+    pub max_tool_force: f64,
+}
+
 impl Report {
     /// Write as pretty JSON, atomically (temp file + rename).
     pub fn write(&self, path: &Path) -> Result<()> {
         let json = serde_json::to_vec_pretty(self)?;
         incise_sim::io::write_atomic(path, &json)
             .with_context(|| format!("writing {}", path.display()))
+    }
+
+    /// One line saying what the run did, in the quantities its model has.
+    pub fn summary(&self) -> String {
+        let n = self.frames.len();
+        let head = format!("completed {n} frames of {}", self.scene);
+        let last = self.frames.last().map(|f| &f.stats);
+        match last {
+            None => head,
+            Some(FrameData::Xpbd(s)) => format!(
+                "{head}: {} tets released, max von Mises {:.0} Pa",
+                s.released_total, s.max_von_mises
+            ),
+            Some(FrameData::Edges(s)) => {
+                let mut line = format!(
+                    "{head} ({}): {} nodes, {} tets, max displacement {:.2} mm, volume ratio {:.4}",
+                    self.model,
+                    self.mesh.nodes,
+                    self.mesh.tets,
+                    s.max_displacement * 1e3,
+                    s.volume_ratio
+                );
+                if let Some(r) = &self.rheology {
+                    line += &format!(
+                        ", dent max {:.2} mm, residual {:.2} mm",
+                        r.max_dent_m * 1e3,
+                        r.residual_dent_m * 1e3
+                    );
+                }
+                if let Some(h) = &self.haptic {
+                    line += &format!(
+                        ", haptic loop {:.0} Hz measured ({} loops in {:.2} s, {:.0} Hz asked), \
+                         max tool force {:.3} N",
+                        h.achieved_hz, h.loops, h.wall_s, h.requested_hz, h.max_tool_force
+                    );
+                }
+                line
+            }
+        }
     }
 }

@@ -10,7 +10,7 @@ use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
 
 use crate::body::{Body, DeviceChoice};
 use crate::progress::Progress;
-use crate::report::{FrameRecord, MaterialInfo, MeshInfo, Report};
+use crate::report::{FrameData, FrameRecord, MaterialInfo, MeshInfo, Report};
 use crate::scene::{BuiltScene, build_scene, load_scene};
 use crate::screenshots::{ImageSize, Screenshots};
 
@@ -35,6 +35,9 @@ pub struct RunOptions {
     pub screenshot_every: u64,
     /// Size of those screenshots.
     pub screenshot_size: ImageSize,
+    /// Run a mass-spring scene's local loop on its own thread at this rate, Hz (the
+    /// haptic-rate option, PHYSICS.md §2.6); `None`: the ordinary frame loop.
+    pub haptic_rate: Option<f64>,
 }
 
 /// What a finished run produced.
@@ -50,8 +53,20 @@ pub struct RunOutcome {
 /// snapshots so far have been written.
 pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let scene = load_scene(&opts.scene)?;
-    if let crate::scene::ModelChoice::MassSpring(ms) = &scene.model {
-        return crate::run_mass_spring::run(&scene, ms, opts);
+    match &scene.model {
+        crate::scene::ModelChoice::MassSpring(ms) => {
+            return crate::run_mass_spring::run(&scene, ms, opts);
+        }
+        crate::scene::ModelChoice::Rheology(rh) => {
+            return crate::run_rheology::run(&scene, rh, opts);
+        }
+        crate::scene::ModelChoice::Xpbd => {}
+    }
+    if opts.haptic_rate.is_some() {
+        bail!(
+            "{}: --haptic-rate runs the mass-spring haptic loop; this scene's model is Xpbd",
+            opts.scene.display()
+        );
     }
     let BuiltScene {
         solver,
@@ -93,6 +108,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let mut report = Report {
         scene: scene.name.clone(),
         scene_file: opts.scene.display().to_string(),
+        model: "xpbd".into(),
         status: "running".into(),
         error: None,
         mesh: MeshInfo {
@@ -106,17 +122,19 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
             grabbed_nodes,
             warnings: mesh_report.warnings.clone(),
         },
-        material: MaterialInfo {
+        material: Some(MaterialInfo {
             name: material_name,
             values: material,
             mu: lame.mu,
             lambda: lame.lambda,
-        },
+        }),
         solver: solver.params().clone(),
         threads,
         device: body.device(),
         frames: Vec::with_capacity(frames as usize),
         snapshots: Vec::new(),
+        rheology: None,
+        haptic: None,
     };
     let report_path = opts.out.join("report.json");
     let mut pvd: Vec<(f64, String)> = Vec::new();
@@ -142,7 +160,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
                     });
                 }
                 report.frames.push(FrameRecord {
-                    stats,
+                    stats: FrameData::Xpbd(stats),
                     wall_ms,
                     gpu_ms: body.gpu_frame_ms(),
                 });

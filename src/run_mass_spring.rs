@@ -1,21 +1,30 @@
 //! `incise run` for mass-spring scenes (PHYSICS.md §2): the tension mass-spring model with
-//! a scripted blade stroke. Writes the same report.json frame fields where they mean
-//! something for this model (von Mises stress is not computed: null), VTU snapshots and
-//! a ParaView collection, like the XPBD runner.
+//! a scripted blade stroke. Writes the quantities this model has to report.json (volume,
+//! displacement, kinetic energy; it computes no stress tensor, so no von Mises field), VTU
+//! snapshots and a ParaView collection, like the XPBD runner.
+//!
+//! With `--haptic-rate HZ` the localised loop runs on its own thread at that rate
+//! (PHYSICS.md §2.6, [`HapticLoop`]), its tool tip at the middle of the scene's blade
+//! edge, and cuts along the stroke in that thread, while this thread runs the report loop
+//! in real time at the scene's frame rate and records the tool force, loop count and
+//! snapshot figures the haptic thread publishes.
 
 use std::path::Path;
 use std::time::Instant;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result, anyhow, bail};
 use glam::{DVec3, Vec3};
 use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
-use incise_sim::mass_spring::{AxisMask, MassSpringModel, MassSpringParams};
+use incise_sim::mass_spring::{
+    AxisMask, HapticConfig, HapticLoop, LocalLoopParams, MassSpringModel, MassSpringParams,
+};
 use incise_sim::nakao_cut::measure::counts;
 use incise_sim::nakao_cut::{BladePose, Cutter};
-use incise_sim::xpbd::FrameStats;
 use incise_sim::{Material, TetMesh};
 
-use crate::report::{FrameRecord, MaterialInfo, MeshInfo, Report};
+use crate::report::{
+    EdgeFrameStats, FrameData, FrameRecord, HapticInfo, MaterialInfo, MeshInfo, Report,
+};
 use crate::run::{RunOptions, RunOutcome};
 use crate::scene::{MassSpringScene, MaterialChoice, Scene, StrokeSpec, load_materials, raw_mesh};
 
@@ -66,6 +75,7 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
     let mut report = Report {
         scene: scene.name.clone(),
         scene_file: opts.scene.display().to_string(),
+        model: "mass-spring".into(),
         status: "running".into(),
         error: None,
         mesh: MeshInfo {
@@ -79,27 +89,90 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
             grabbed_nodes: 0,
             warnings: mesh_report.warnings.clone(),
         },
-        material: MaterialInfo {
+        material: Some(MaterialInfo {
             name: material_name,
             values: material,
             mu: lame.mu,
             lambda: lame.lambda,
-        },
+        }),
         solver: scene.solver.clone(),
         threads: 1,
         device: "cpu (mass-spring)".into(),
         frames: Vec::with_capacity(frames as usize),
         snapshots: Vec::new(),
+        rheology: None,
+        haptic: None,
     };
     let total_volume: f64 = (0..model.tet_count())
         .map(|t| model.reference_volume(t))
         .sum();
-    let mut cutter = Cutter::new(ms.cut.clone());
-    let mut cutting = false;
     let mut pvd: Vec<(f64, String)> = Vec::new();
     if opts.vtu_every > 0 {
         snapshot(&opts.out, &model, 0, &mut pvd)?;
     }
+    let model = match opts.haptic_rate {
+        Some(rate) => {
+            let stroke = ms.stroke.as_ref().ok_or_else(|| {
+                anyhow!(
+                    "{}: --haptic-rate moves the haptic tool along model.stroke, and this \
+                     scene has none",
+                    opts.scene.display()
+                )
+            })?;
+            let (model, haptic) =
+                run_haptic(model, ms, stroke, rate, frame_dt, frames, &mut report)?;
+            report.haptic = Some(haptic);
+            model
+        }
+        None => run_frames(
+            model,
+            ms,
+            frame_dt,
+            frames,
+            total_volume,
+            opts,
+            &mut report,
+            &mut pvd,
+        )?,
+    };
+    if !pvd.is_empty() {
+        write_pvd(&opts.out.join("run.pvd"), &pvd)?;
+        report.snapshots = pvd.iter().map(|(_, f)| f.clone()).collect();
+    }
+    let after = counts(&model);
+    report.mesh.nodes = after.nodes;
+    report.mesh.tets = after.tets;
+    report.mesh.skin_vertices = after.nodes;
+    report.mesh.skin_triangles = after.triangles;
+    report.status = "completed".into();
+    let report_path = opts.out.join("report.json");
+    report.write(&report_path)?;
+    if !opts.quiet {
+        eprintln!(
+            "mass-spring: {} nodes, {} tets, {} edges after {} frames",
+            after.nodes, after.tets, after.edges, frames
+        );
+    }
+    Ok(RunOutcome {
+        report_path,
+        report,
+    })
+}
+
+/// The ordinary run: cut along the stroke and step the model frame by frame; returns it.
+#[allow(clippy::too_many_arguments)]
+fn run_frames(
+    mut model: MassSpringModel,
+    ms: &MassSpringScene,
+    frame_dt: f64,
+    frames: u64,
+    total_volume: f64,
+    opts: &RunOptions,
+    report: &mut Report,
+    pvd: &mut Vec<(f64, String)>,
+) -> Result<MassSpringModel> {
+    let mut cutter = Cutter::new(ms.cut.clone());
+    let mut cutting = false;
     for f in 0..frames {
         let t0 = Instant::now();
         if let Some(stroke) = &ms.stroke {
@@ -122,54 +195,134 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
             .map(|t| model.current_volume(t))
             .sum();
         report.frames.push(FrameRecord {
-            stats: FrameStats {
+            stats: FrameData::Edges(EdgeFrameStats {
                 frame: f,
                 sim_time: model.time(),
-                substeps: steps,
-                max_von_mises: f32::NAN,
-                mean_von_mises: f32::NAN,
-                released_now: 0,
-                released_total: 0,
-                retired_nodes: 0,
+                substeps: steps as u64,
                 volume_ratio: volume / total_volume,
-                kinetic_energy: model.kinetic_energy(),
-                solve_ms: wall_ms,
-                stress_ms: 0.0,
-            },
+                max_displacement: max_displacement(model.reference_positions(), model.positions()),
+                kinetic_energy: Some(model.kinetic_energy()),
+                solve_ms: Some(wall_ms),
+                ..EdgeFrameStats::default()
+            }),
             wall_ms,
             gpu_ms: None,
         });
         if opts.vtu_every > 0 && (f + 1) % opts.vtu_every == 0 {
-            snapshot(&opts.out, &model, f + 1, &mut pvd)?;
+            snapshot(&opts.out, &model, f + 1, pvd)?;
         }
     }
-    if !pvd.is_empty() {
-        write_pvd(&opts.out.join("run.pvd"), &pvd)?;
-        report.snapshots = pvd.iter().map(|(_, f)| f.clone()).collect();
+    Ok(model)
+}
+
+/// The haptic-rate run: the local loop on its own thread at `rate` Hz with its tool at
+/// the middle of the blade edge, cutting along the stroke; this thread wakes every
+/// `frame_dt` of wall time for `frames` frames, moves the tool and the blade to where the
+/// stroke is at the haptic thread's simulated time, and records what that thread
+/// published. Returns the model and the measured loop figures.
+fn run_haptic(
+    model: MassSpringModel,
+    ms: &MassSpringScene,
+    stroke: &StrokeSpec,
+    rate: f64,
+    frame_dt: f64,
+    frames: u64,
+    report: &mut Report,
+) -> Result<(MassSpringModel, HapticInfo)> {
+    let tool = |pose: BladePose| (pose.heel + pose.tip) * 0.5;
+    let config = HapticConfig {
+        rate_hz: rate,
+        publish_hz: 1.0 / frame_dt,
+        local: LocalLoopParams::default(),
+        cut: ms.cut.clone(),
+        ..HapticConfig::default()
+    };
+    let start = Instant::now();
+    let haptic = HapticLoop::spawn(model, config);
+    haptic.set_tool(Some(tool(blade_at(stroke, 0.0).0)));
+    let (mut previous_loops, mut max_force, mut blade_down) = (0u64, 0.0f64, false);
+    for f in 0..frames {
+        let deadline = start + std::time::Duration::from_secs_f64((f + 1) as f64 * frame_dt);
+        let now = Instant::now();
+        if now < deadline {
+            std::thread::sleep(deadline - now);
+        }
+        let t0 = Instant::now();
+        let latest = haptic.latest();
+        let (pose, progress) = blade_at(stroke, latest.sim_time);
+        haptic.set_tool(Some(tool(pose)));
+        // The stroke's first pose places the blade; later ones cut; its end lifts it.
+        if progress > 0.0 && progress < 1.0 {
+            let pose = if blade_down {
+                pose
+            } else {
+                blade_at(stroke, stroke.start as f64).0
+            };
+            haptic.set_blade(Some(pose));
+            blade_down = true;
+        } else if blade_down && progress >= 1.0 {
+            haptic.set_blade(Some(pose));
+            blade_down = false;
+        } else {
+            haptic.set_blade(None);
+        }
+        let force = latest.tool_force;
+        max_force = max_force.max(force.length());
+        report.frames.push(FrameRecord {
+            stats: FrameData::Edges(EdgeFrameStats {
+                frame: f,
+                sim_time: latest.sim_time,
+                substeps: latest.loops - previous_loops,
+                volume_ratio: latest.volume_ratio,
+                max_displacement: latest.max_displacement,
+                kinetic_energy: Some(latest.kinetic_energy),
+                solve_ms: None,
+                tool_force: Some(force.to_array()),
+                haptic_loops: Some(latest.loops),
+                ..EdgeFrameStats::default()
+            }),
+            wall_ms: t0.elapsed().as_secs_f64() * 1e3,
+            gpu_ms: None,
+        });
+        previous_loops = latest.loops;
     }
-    let after = counts(&model);
-    report.mesh.nodes = after.nodes;
-    report.mesh.tets = after.tets;
-    report.mesh.skin_vertices = after.nodes;
-    report.mesh.skin_triangles = after.triangles;
-    report.status = "completed".into();
-    let report_path = opts.out.join("report.json");
-    report.write(&report_path)?;
-    if !opts.quiet {
-        println!(
-            "mass-spring: {} nodes, {} tets, {} edges after {} frames",
-            after.nodes, after.tets, after.edges, frames
-        );
+    let last = haptic.latest();
+    let wall_s = start.elapsed().as_secs_f64();
+    let model = haptic
+        .stop()
+        .map_err(|_| anyhow!("the haptic thread panicked"))?;
+    let info = HapticInfo {
+        requested_hz: rate,
+        loops: last.loops,
+        wall_s,
+        achieved_hz: last.loops as f64 / wall_s,
+        overruns: last.overruns,
+        sim_time: last.sim_time,
+        snapshots: last.snapshots,
+        report_hz: 1.0 / frame_dt,
+        cut_advances: last.cut_advances,
+        last_tool_force: last.tool_force.to_array(),
+        max_tool_force: max_force.max(last.tool_force.length()),
+    };
+    if !(info.achieved_hz.is_finite() && info.last_tool_force.iter().all(|f| f.is_finite())) {
+        bail!("the haptic loop produced a non-finite rate or tool force: {info:?}");
     }
-    Ok(RunOutcome {
-        report_path,
-        report,
-    })
+    Ok((model, info))
+}
+
+/// Largest distance of a node from its reference position, m.
+fn max_displacement(reference: &[DVec3], x: &[DVec3]) -> f64 {
+    reference
+        .iter()
+        .zip(x)
+        .map(|(r, p)| (*p - *r).length())
+        .fold(0.0, f64::max)
 }
 
 /// The scene's material, resolving a preset from `materials.ron` beside the scene.
 fn material(scene: &Scene, dir: &Path, scene_path: &Path) -> Result<(Material, String)> {
     Ok(match &scene.material {
+        MaterialChoice::Unset => bail!("{}: material is missing", scene_path.display()),
         MaterialChoice::Custom(m) => (*m, "custom".to_string()),
         MaterialChoice::Preset(name) => {
             let file = dir.join("materials.ron");

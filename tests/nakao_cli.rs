@@ -1,6 +1,7 @@
 //! End-to-end tests of the mass-spring parts of the `incise` binary: a `MassSpring` scene
-//! runs and reports, a bad model field is named with its line, and the loop benchmark
-//! prints its JSON.
+//! runs and reports the quantities the model has (never NaN), the haptic-rate loop runs
+//! from the CLI and reports what it measured, a bad model field is named with its line,
+//! and the loop benchmark prints its JSON.
 
 mod common;
 
@@ -21,9 +22,24 @@ fn shipped_nakao_scene_cuts_and_reports() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    // The summary names what the model computes, not a stress it does not.
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains("(mass-spring)") && stdout.contains("max displacement"),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.contains("NaN") && !stdout.contains("von Mises"),
+        "{stdout}"
+    );
+    let json = std::fs::read_to_string(out.join("report.json")).unwrap();
+    assert!(
+        !json.contains("NaN") && !json.contains("von_mises"),
+        "{json}"
+    );
+    let report: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(report["status"], "completed");
+    assert_eq!(report["model"], "mass-spring");
     assert_eq!(report["device"], "cpu (mass-spring)");
     let frames = report["frames"].as_array().unwrap();
     assert_eq!(frames.len(), 60);
@@ -32,14 +48,122 @@ fn shipped_nakao_scene_cuts_and_reports() {
         "substeps",
         "kinetic_energy",
         "volume_ratio",
+        "max_displacement",
         "wall_ms",
     ] {
         assert!(frames[0].get(key).is_some(), "frame record lacks {key}");
     }
+    for frame in frames {
+        for (key, value) in frame.as_object().unwrap() {
+            assert!(value.is_number(), "frame field {key} is {value}");
+        }
+    }
+    // The tension opens the wound: nodes have moved.
+    assert!(frames.last().unwrap()["max_displacement"].as_f64().unwrap() > 1e-4);
     // The blade starts at 0.2 s and runs 0.4 s in these 0.6 s: the mesh has grown.
     assert!(report["mesh"]["nodes"].as_u64().unwrap() > 1_250);
     assert!(report["mesh"]["tets"].as_u64().unwrap() > 3_456);
     assert!(out.join("run.pvd").exists() && out.join("snap_00060.vtu").exists());
+}
+
+#[test]
+fn haptic_rate_loop_runs_beside_the_report_loop() {
+    let out = temp_dir("haptic");
+    // 60 report frames of 10 ms: 0.6 s of wall time with the 1 kHz loop beside them.
+    let o = incise(&[
+        "run",
+        "config/plate_cut_nakao.ron",
+        "--haptic-rate",
+        "1000",
+        "--frames",
+        "60",
+        "--vtu-every",
+        "0",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains("haptic loop") && !stdout.contains("NaN"),
+        "{stdout}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["status"], "completed");
+    let h = &report["haptic"];
+    let loops = h["loops"].as_u64().unwrap();
+    let wall = h["wall_s"].as_f64().unwrap();
+    let rate = h["achieved_hz"].as_f64().unwrap();
+    assert_eq!(h["requested_hz"], 1000.0);
+    assert!(loops > 0, "the haptic thread ran no loop");
+    assert!(wall >= 0.6, "the report loop ran in real time: {wall} s");
+    // The rate reported is the one measured: loops over wall time.
+    assert!((rate - loops as f64 / wall).abs() < 1e-6 * rate, "{h}");
+    // The loop sleeps to its period, so it cannot run much faster than asked (loose bound:
+    // how much slower it runs depends on the machine's load and is not tested).
+    assert!(rate <= 1100.0, "{h}");
+    // The simulated time is the loops' own: 1 ms each.
+    let sim = h["sim_time"].as_f64().unwrap();
+    assert!((sim - loops as f64 * 1e-3).abs() < 2e-3, "{h}");
+    let force: Vec<f64> = h["last_tool_force"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_f64().unwrap())
+        .collect();
+    assert!(force.iter().all(|f| f.is_finite()), "{force:?}");
+    let frames = report["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 60);
+    // Each frame carries the published force and a loop count that never decreases.
+    let counts: Vec<u64> = frames
+        .iter()
+        .map(|f| f["haptic_loops"].as_u64().unwrap())
+        .collect();
+    assert!(counts.windows(2).all(|w| w[1] >= w[0]) && *counts.last().unwrap() <= loops);
+    assert!(
+        frames
+            .iter()
+            .all(|f| f["tool_force"].as_array().unwrap().len() == 3)
+    );
+    // The tool sits on the plate's top surface at the blade's edge: the virtual spring
+    // to the nearest node pulls, so some frame records a non-zero force.
+    assert!(h["max_tool_force"].as_f64().unwrap() > 0.0, "{h}");
+    // The blade starts at 0.2 s of simulated time; once the haptic thread has simulated
+    // 0.1 s beyond that (not guaranteed on a loaded machine) it has cut the plate.
+    let cuts = h["cut_advances"].as_u64().unwrap();
+    let nodes = report["mesh"]["nodes"].as_u64().unwrap();
+    eprintln!("haptic: {loops} loops in {wall:.3} s, sim {sim:.3} s, {cuts} cuts, {nodes} nodes");
+    if sim >= 0.3 {
+        assert!(cuts > 0 && nodes > 1_250, "{h}, {nodes} nodes");
+    }
+}
+
+#[test]
+fn haptic_rate_needs_a_mass_spring_scene_with_a_stroke() {
+    let o = incise(&[
+        "run",
+        "config/organ_layers.ron",
+        "--haptic-rate",
+        "1000",
+        "--quiet",
+        "--out",
+        temp_dir("haptic_bad").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o.stderr).contains("--haptic-rate"),
+        "{}",
+        text(&o.stderr)
+    );
+    let o = incise(&["run", "config/plate_cut_nakao.ron", "--haptic-rate", "0"]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o.stderr).contains("haptic-rate"),
+        "{}",
+        text(&o.stderr)
+    );
 }
 
 #[test]

@@ -30,6 +30,17 @@ pub struct BuiltScene {
 /// Build `scene` (read from `scene_path`, whose folder anchors relative paths); presets
 /// come from `materials.ron` beside the scene file.
 pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> Result<BuiltScene> {
+    let model = match &scene.model {
+        super::ModelChoice::Xpbd => None,
+        super::ModelChoice::MassSpring(_) => Some("MassSpring"),
+        super::ModelChoice::Rheology(_) => Some("Rheology"),
+    };
+    if let Some(model) = model {
+        return Err(anyhow!(
+            "{}: model {model} runs with `incise run` only; this command needs an Xpbd scene",
+            scene_path.display()
+        ));
+    }
     let dir = scene_path.parent().unwrap_or(Path::new("."));
     let (raw, generated_skin) = raw_mesh(&scene.mesh, dir)?;
     let (mesh, mesh_report) =
@@ -46,6 +57,9 @@ pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> 
         }
     };
     let (material, material_name) = match &scene.material {
+        MaterialChoice::Unset => {
+            return Err(anyhow!("{}: material is missing", scene_path.display()));
+        }
         MaterialChoice::Custom(m) => (*m, "custom".to_string()),
         MaterialChoice::Preset(name) => {
             let file = dir.join("materials.ron");

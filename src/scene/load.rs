@@ -58,7 +58,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let scene: Scene = ron::from_str(text).map_err(|e| syntax(path, e))?;
     let value_err = |field: &str, msg: String| SceneError::Value {
         path: path.into(),
-        line: field_line(text, field.rsplit('.').next().unwrap_or(field)),
+        line: locate(text, field),
         field: field.to_string(),
         msg,
     };
@@ -90,9 +90,32 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
             ));
         }
     }
-    if let super::ModelChoice::MassSpring(ms) = &scene.model {
-        ms.validate()
-            .map_err(|(field, msg)| value_err(&field, msg))?;
+    match (&scene.model, &scene.material) {
+        (super::ModelChoice::Rheology(rh), material) => {
+            if !matches!(material, MaterialChoice::Unset) {
+                return Err(value_err(
+                    "material",
+                    "is not used by a Rheology model: its presets are named in \
+                     model.material and model.regions; remove this field"
+                        .into(),
+                ));
+            }
+            rh.validate()
+                .map_err(|(field, msg)| value_err(&field, msg))?;
+        }
+        (_, MaterialChoice::Unset) => {
+            return Err(value_err(
+                "material",
+                "is missing: Xpbd and MassSpring scenes need Preset(\"name\") or \
+                 Custom((youngs_modulus: …, poisson_ratio: …, density: …))"
+                    .into(),
+            ));
+        }
+        (super::ModelChoice::MassSpring(ms), _) => {
+            ms.validate()
+                .map_err(|(field, msg)| value_err(&field, msg))?;
+        }
+        (super::ModelChoice::Xpbd, _) => {}
     }
     for (i, g) in scene.grabs.iter().enumerate() {
         if !(g.speed.is_finite() && g.speed > 0.0) {
@@ -141,6 +164,43 @@ fn syntax(path: &Path, e: ron::error::SpannedError) -> SceneError {
         line: e.span.start.line,
         col: e.span.start.col,
         msg: e.code.to_string(),
+    }
+}
+
+/// 1-based line of the dotted `field` in scene text (0 when not found): the first line of
+/// its last name, except inside `model.regions[i]`, where it is looked for from the i-th
+/// region on (each region has one `tets:` line).
+pub fn locate(text: &str, field: &str) -> usize {
+    let last = field.rsplit('.').next().unwrap_or(field);
+    let Some(rest) = field.strip_prefix("model.regions[") else {
+        return field_line(text, last);
+    };
+    let Some(index) = rest.split(']').next().and_then(|i| i.parse::<usize>().ok()) else {
+        return field_line(text, last);
+    };
+    let start = field_line(text, "regions");
+    if start == 0 {
+        return 0;
+    }
+    let after: String = text.lines().skip(start - 1).collect::<Vec<_>>().join("\n");
+    // Line (within `after`) of the region's `tets:`, then of the field from there on.
+    let mut offset = 0;
+    for _ in 0..=index {
+        let tail: String = after.lines().skip(offset).collect::<Vec<_>>().join("\n");
+        match field_line(&tail, "tets") {
+            0 => return field_line(text, last),
+            l => offset += l,
+        }
+    }
+    let region_start = offset - 1;
+    let tail: String = after
+        .lines()
+        .skip(region_start)
+        .collect::<Vec<_>>()
+        .join("\n");
+    match field_line(&tail, last) {
+        0 => start + region_start,
+        l => start + region_start + l - 1,
     }
 }
 
@@ -203,6 +263,35 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("t.ron:5: duration"), "{e}");
+    }
+
+    #[test]
+    fn missing_material_and_region_fields_are_located() {
+        let bare = GOOD.replace(
+            "material: Custom((youngs_modulus: 1e4, poisson_ratio: 0.3, density: 1000)),\n",
+            "",
+        );
+        let e = parse_scene(&bare, Path::new("t.ron"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("material is missing"), "{e}");
+        let text = "(\n model: Rheology((\n  material: \"a\",\n  regions: [\n   (tets: Tets([0]), material: \"b\"),\n   (\n    tets: Tets([]),\n    material: \"c\",\n   ),\n  ],\n )),\n)";
+        assert_eq!(locate(text, "model.material"), 3);
+        assert_eq!(locate(text, "model.regions[0].material"), 5);
+        assert_eq!(locate(text, "model.regions[1].tets"), 7);
+        assert_eq!(locate(text, "model.regions[1].material"), 8);
+    }
+
+    #[test]
+    fn shipped_scenes_all_parse() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
+        for entry in std::fs::read_dir(&root).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            if name.ends_with(".ron") && name != "materials.ron" && name != "rheology.ron" {
+                load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+            }
+        }
     }
 
     #[test]

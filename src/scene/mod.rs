@@ -7,8 +7,11 @@ mod model;
 
 pub use build::raw_mesh;
 pub use build::{BuiltScene, build_scene};
-pub use load::{SceneError, load_materials, load_scene, parse_scene};
-pub use model::{HoldSpec, MassSpringScene, ModelChoice, StrokeSpec};
+pub use load::{SceneError, load_materials, load_scene, locate, parse_scene};
+pub use model::{
+    HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
+    StrokeSpec,
+};
 
 use glam::{UVec3, Vec3};
 use incise_sim::Material;
@@ -29,6 +32,9 @@ pub struct Scene {
     #[serde(default)]
     pub skin: SkinSource,
     /// Tissue material: a preset name from `config/materials.ron` or explicit values.
+    /// Required by the `Xpbd` and `MassSpring` models; a `Rheology` model names its own
+    /// materials (per region) and must leave this out.
+    #[serde(default)]
     pub material: MaterialChoice,
     /// Node sets fixed in place.
     #[serde(default)]
@@ -44,7 +50,8 @@ pub struct Scene {
     pub cutting: Option<Cutting>,
     /// Simulated duration, s.
     pub duration: f32,
-    /// Simulation model: `Xpbd` (default) or `MassSpring(...)` (PHYSICS.md §2).
+    /// Simulation model: `Xpbd` (default), `MassSpring(...)` (PHYSICS.md §2) or
+    /// `Rheology(...)` (PHYSICS.md §3).
     #[serde(default)]
     pub model: ModelChoice,
 }
@@ -135,8 +142,11 @@ pub enum SkinSource {
 }
 
 /// A material by preset name or by value.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize)]
 pub enum MaterialChoice {
+    /// Not given in the scene (allowed for `Rheology` models only).
+    #[default]
+    Unset,
     /// A key of `config/materials.ron`.
     Preset(String),
     /// Explicit values.

@@ -1,7 +1,8 @@
-//! Which simulation model a scene uses: the XPBD Neo-Hookean solver (default) or the
-//! Nakao 2003 tension mass-spring cutter (PHYSICS.md §2).
+//! Which simulation model a scene uses: the XPBD Neo-Hookean solver (default), the
+//! Nakao 2003 tension mass-spring cutter (PHYSICS.md §2) or the three-element rheological
+//! body with a material per region (PHYSICS.md §3).
 
-use glam::Vec3;
+use glam::{DVec2, Vec3};
 use incise_sim::mass_spring::Tension;
 use incise_sim::nakao_cut::CutParams;
 use incise_sim::selection::NodeSelection;
@@ -17,6 +18,132 @@ pub enum ModelChoice {
     /// the material's density; its Young's modulus and Poisson ratio are not used (the
     /// springs have their own constant).
     MassSpring(MassSpringScene),
+    /// Three-element rheological elements on every tet edge, integrated with RK4
+    /// (PHYSICS.md §3), each region of the mesh with its own preset.
+    Rheology(RheologyScene),
+}
+
+/// Settings of a rheology scene: the materials per region and an optional flat indenter.
+///
+/// Which tet and edge takes which material: every tet takes `material`, then each region
+/// in order, a later region winning. A `Nodes` region covers the tets whose **four** nodes
+/// it selects (a tet straddling its border stays outside), a `Tets` region the tets it
+/// lists. An edge takes the material of the last-listed region among the tets that share
+/// it, so the edges on an interface between two regions belong to the later one. Node
+/// masses use each tet's own density.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RheologyScene {
+    /// The preset file, relative to the scene file.
+    #[serde(default = "default_presets")]
+    pub presets: String,
+    /// Preset name of every tet outside the regions.
+    pub material: String,
+    /// Regions with their own preset, in order (a later one wins where they overlap).
+    #[serde(default)]
+    pub regions: Vec<RegionSpec>,
+    /// A rigid flat indenter pressing the body's top; absent: none (gravity or pins only).
+    #[serde(default)]
+    pub indenter: Option<IndenterSpec>,
+}
+
+fn default_presets() -> String {
+    "rheology.ron".into()
+}
+
+/// A part of the mesh and the preset it takes.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RegionSpec {
+    /// Which tets.
+    pub tets: RegionSelect,
+    /// Preset name in the scene's preset file.
+    pub material: String,
+}
+
+/// How a region picks its tets.
+#[derive(Debug, Clone, Deserialize)]
+pub enum RegionSelect {
+    /// The tets whose four nodes the selection picks (by rest position or index).
+    Nodes(NodeSelection),
+    /// Explicit 0-based tet indices.
+    Tets(Vec<u32>),
+}
+
+/// A flat rectangular indenter over the mesh's top (highest rest z): pressed down to
+/// `depth` in `press` s, held `hold` s, lifted in `lift` s (the seed's press-and-release).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IndenterSpec {
+    /// Centre of the face in x, y, m.
+    pub centre: DVec2,
+    /// Half extents of the face in x, y, m.
+    pub half_size: DVec2,
+    /// Depth of the face below the rest top at full press, m.
+    pub depth: f64,
+    /// Press ramp, s.
+    pub press: f64,
+    /// Hold at full depth, s.
+    #[serde(default)]
+    pub hold: f64,
+    /// Lift-off ramp, s.
+    pub lift: f64,
+}
+
+impl RheologyScene {
+    /// Ok, or the first bad field (dotted path) and why.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        if self.material.trim().is_empty() {
+            return Err(("model.material".into(), "must name a preset".into()));
+        }
+        for (i, r) in self.regions.iter().enumerate() {
+            if r.material.trim().is_empty() {
+                return Err((
+                    format!("model.regions[{i}].material"),
+                    "must name a preset".into(),
+                ));
+            }
+            if let RegionSelect::Tets(list) = &r.tets {
+                if list.is_empty() {
+                    return Err((
+                        format!("model.regions[{i}].tets"),
+                        "lists no tet: a region must cover at least one".into(),
+                    ));
+                }
+            }
+        }
+        if let Some(ind) = &self.indenter {
+            let positive = |x: f64| x.is_finite() && x > 0.0;
+            if !ind.centre.is_finite() {
+                return Err(("model.indenter.centre".into(), "must be finite".into()));
+            }
+            if !(positive(ind.half_size.x) && positive(ind.half_size.y)) {
+                return Err((
+                    "model.indenter.half_size".into(),
+                    format!("must be positive lengths in m, got {}", ind.half_size),
+                ));
+            }
+            for (field, value) in [
+                ("depth", ind.depth),
+                ("press", ind.press),
+                ("lift", ind.lift),
+            ] {
+                if !positive(value) {
+                    return Err((
+                        format!("model.indenter.{field}"),
+                        format!("must be > 0, got {value}"),
+                    ));
+                }
+            }
+            if !(ind.hold.is_finite() && ind.hold >= 0.0) {
+                return Err((
+                    "model.indenter.hold".into(),
+                    format!("must be >= 0 s, got {}", ind.hold),
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Settings of a mass-spring scene.

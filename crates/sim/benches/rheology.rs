@@ -79,7 +79,8 @@ impl SpringNetwork {
                 let (i, j) = (3 * i as usize, 3 * j as usize);
                 let d = DVec3::from_slice(&x[j..j + 3]) - DVec3::from_slice(&x[i..i + 3]);
                 let len = d.length();
-                let dir = d / len;
+                // One reciprocal, as the rheological body's edge pass does.
+                let dir = d * (1.0 / len);
                 let rate =
                     (DVec3::from_slice(&v[j..j + 3]) - DVec3::from_slice(&v[i..i + 3])).dot(dir);
                 *f = dir * (stiffness[e] * (len - rest[e]) + damping[e] * rate);

@@ -1,7 +1,8 @@
 //! The haptic-rate loop (PHYSICS.md §2.6: 1000 Hz haptic, 100 Hz visual): the localised
 //! mass-spring simulation runs on its own thread at a fixed rate, couples the tool to the
 //! node nearest it with a virtual spring, and publishes the tool force every loop and a
-//! position snapshot for rendering at a lower rate.
+//! position snapshot for rendering at a lower rate. A blade pose handed to it is cut in
+//! the same thread (PHYSICS.md §2.3–2.4), before the loop's integration, whenever it moves.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -11,6 +12,7 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 
 use super::{LocalLoop, LocalLoopParams, MassSpringModel, SystemClock};
+use crate::nakao_cut::{BladePose, CutParams, Cutter};
 
 /// Settings of the haptic loop.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,6 +27,8 @@ pub struct HapticConfig {
     pub coupling: f64,
     /// The tool touches the tissue when its tip is within this distance of a node, m.
     pub contact_radius: f64,
+    /// Settings of the cutter that cuts along the blade poses (see [`HapticLoop::set_blade`]).
+    pub cut: CutParams,
 }
 
 impl Default for HapticConfig {
@@ -35,6 +39,7 @@ impl Default for HapticConfig {
             local: LocalLoopParams::default(),
             coupling: 50.0,
             contact_radius: 0.005,
+            cut: CutParams::default(),
         }
     }
 }
@@ -56,10 +61,23 @@ pub struct HapticFrame {
     pub positions: Vec<DVec3>,
     /// Snapshots published so far.
     pub snapshots: u64,
+    /// Blade advances cut so far (each one a swept region between two poses).
+    pub cut_advances: u64,
+    /// Node count at the last snapshot (grows as the blade cuts).
+    pub nodes: usize,
+    /// Tet count at the last snapshot.
+    pub tets: usize,
+    /// Current tet volume over reference volume at the last snapshot.
+    pub volume_ratio: f64,
+    /// Kinetic energy at the last snapshot, J.
+    pub kinetic_energy: f64,
+    /// Largest node displacement from the reference position at the last snapshot, m.
+    pub max_displacement: f64,
 }
 
 struct Shared {
     tool: Mutex<Option<DVec3>>,
+    blade: Mutex<Option<BladePose>>,
     frame: Mutex<HapticFrame>,
     stop: AtomicBool,
 }
@@ -75,6 +93,7 @@ impl HapticLoop {
     pub fn spawn(model: MassSpringModel, config: HapticConfig) -> HapticLoop {
         let shared = Arc::new(Shared {
             tool: Mutex::new(None),
+            blade: Mutex::new(None),
             frame: Mutex::new(HapticFrame::default()),
             stop: AtomicBool::new(false),
         });
@@ -87,6 +106,15 @@ impl HapticLoop {
     pub fn set_tool(&self, tip: Option<DVec3>) {
         if let Ok(mut t) = self.shared.tool.lock() {
             *t = tip;
+        }
+    }
+
+    /// Move the blade's cutting edge (`None`: blade lifted, the stroke ends). The haptic
+    /// thread cuts what the edge swept since the pose it last saw; the first pose after a
+    /// lift only places the blade.
+    pub fn set_blade(&self, pose: Option<BladePose>) {
+        if let Ok(mut b) = self.shared.blade.lock() {
+            *b = pose;
         }
     }
 
@@ -112,10 +140,24 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
         .round()
         .max(1.0) as u64;
     let mut local = LocalLoop::new(config.local.clone(), SystemClock::default());
+    let mut cutter = Cutter::new(config.cut.clone());
+    let mut blade_seen: Option<BladePose> = None;
     let mut next = Instant::now() + period;
-    let (mut loops, mut overruns, mut snapshots) = (0u64, 0u64, 0u64);
+    let (mut loops, mut overruns, mut snapshots, mut cuts) = (0u64, 0u64, 0u64, 0u64);
     while !shared.stop.load(Ordering::Acquire) {
         let tip = shared.tool.lock().ok().and_then(|t| *t);
+        let blade = shared.blade.lock().ok().and_then(|b| *b);
+        match (blade, blade_seen) {
+            (Some(pose), Some(seen)) if pose == seen => {}
+            (Some(pose), seen) => {
+                // The first pose of a stroke only places the blade.
+                cutter.advance(&mut model, pose);
+                cuts += u64::from(seen.is_some());
+            }
+            (None, Some(_)) => cutter.end(),
+            (None, None) => {}
+        }
+        blade_seen = blade;
         let h = period.as_secs_f64();
         let substeps = (h / model.stable_dt()).ceil().max(1.0) as u32;
         let dt = h / substeps as f64;
@@ -152,11 +194,27 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
             f.overruns = overruns;
             f.sim_time = model.time();
             f.free_nodes = free;
+            f.cut_advances = cuts;
             if publish {
                 snapshots += 1;
                 f.positions.clear();
                 f.positions.extend_from_slice(model.positions());
                 f.snapshots = snapshots;
+                f.nodes = model.node_count();
+                f.tets = model.tet_count();
+                let (mut now, mut reference) = (0.0, 0.0);
+                for t in 0..model.tet_count() {
+                    now += model.current_volume(t);
+                    reference += model.reference_volume(t);
+                }
+                f.volume_ratio = now / reference;
+                f.kinetic_energy = model.kinetic_energy();
+                f.max_displacement = model
+                    .positions()
+                    .iter()
+                    .zip(model.reference_positions())
+                    .map(|(p, r)| (*p - *r).length())
+                    .fold(0.0, f64::max);
             }
         }
         let now = Instant::now();
@@ -216,5 +274,54 @@ mod tests {
         assert!(frame.tool_force.z > 0.0, "{}", frame.tool_force);
         assert!((model.time() - frame.sim_time).abs() < 0.1);
         assert!(frame.sim_time > 0.0);
+        assert_eq!(
+            (frame.nodes, frame.tets),
+            (model.node_count(), model.tet_count())
+        );
+        assert!(frame.volume_ratio > 0.9 && frame.volume_ratio <= 1.0 + 1e-9);
+        assert_eq!(frame.cut_advances, 0);
+    }
+
+    #[test]
+    fn blade_handed_to_the_haptic_thread_cuts() {
+        let (mesh, _) = TetMesh::from_raw(block(
+            Vec3::ZERO,
+            Vec3::new(0.04, 0.04, 0.01),
+            UVec3::new(4, 4, 1),
+        ))
+        .unwrap();
+        let m = MassSpringModel::new(
+            &mesh,
+            MassSpringParams {
+                gravity: DVec3::ZERO,
+                ..MassSpringParams::default()
+            },
+        )
+        .unwrap();
+        let nodes = m.node_count();
+        let haptic = HapticLoop::spawn(m, HapticConfig::default());
+        // A vertical blade through the block at y = 0.021, moved along x in 5 mm steps.
+        let pose = |x: f64| BladePose {
+            heel: DVec3::new(x, 0.021, -0.005),
+            tip: DVec3::new(x, 0.021, 0.015),
+        };
+        for k in 0..=6 {
+            haptic.set_blade(Some(pose(-0.005 + 0.005 * k as f64)));
+            // Give the thread time to see each pose (a 1 kHz loop: ≈ 20 loops).
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        haptic.set_blade(None);
+        std::thread::sleep(Duration::from_millis(20));
+        let frame = haptic.latest();
+        let model = haptic.stop().unwrap();
+        assert!(frame.cut_advances >= 1, "{} advances", frame.cut_advances);
+        // The adaptive cut snaps nodes onto the cut and duplicates them to open it.
+        assert!(
+            model.node_count() > nodes,
+            "the blade cut nothing: {} nodes",
+            model.node_count()
+        );
+        let mass = (model.total_mass() - model.initial_mass()).abs() / model.initial_mass();
+        assert!(mass < 1e-9, "mass changed by {mass}");
     }
 }

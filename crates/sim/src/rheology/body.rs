@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use crate::mesh::{EdgeList, TetMesh};
 
+use super::edge_law::EdgeLaw;
 use super::error::RheologyError;
 use super::indenter::FlatIndenter;
 use super::material::RheologyMaterial;
@@ -25,6 +26,8 @@ pub struct RheologyBody {
     edges: EdgeList,
     /// The materials; edge `e` takes `materials[map.edge_material[e]]`.
     materials: Vec<RheologyMaterial>,
+    /// Each material's element law with its constants folded (the force pass's view).
+    laws: Vec<EdgeLaw>,
     map: MaterialMap,
     /// Rest length L0 of every edge (f64, from the rest positions), m.
     rest_length: Vec<f64>,
@@ -41,12 +44,12 @@ pub struct RheologyBody {
 
 /// What the force passes read: the constant part of a body.
 ///
-/// Element constants are made per edge and stage from the material and the rest length
-/// (a few multiplications) rather than stored: 12 bytes read per edge instead of ~90 keeps
-/// a plate-sized body in cache.
+/// Element constants are made per edge and stage from the material's folded law and the
+/// rest length (a few multiplications) rather than stored: 12 bytes read per edge instead
+/// of ~90 keeps a plate-sized body in cache.
 struct Forces<'a> {
     edges: &'a EdgeList,
-    materials: &'a [RheologyMaterial],
+    laws: &'a [EdgeLaw],
     edge_material: &'a [u32],
     rest_length: &'a [f64],
     masses: &'a [f64],
@@ -117,6 +120,7 @@ impl RheologyBody {
             state[6 * n + e] = materials[map.edge_material[e] as usize].rest_ratio;
         }
         let materials = materials.to_vec();
+        let laws = materials.iter().map(EdgeLaw::of).collect();
         let pinned = vec![false; n];
         let limit = stability_limit(
             &edges.edges,
@@ -129,6 +133,7 @@ impl RheologyBody {
         Ok(RheologyBody {
             edges,
             materials,
+            laws,
             map,
             rest_length,
             masses,
@@ -277,7 +282,7 @@ impl RheologyBody {
         }
         let forces = Forces {
             edges: &self.edges,
-            materials: &self.materials,
+            laws: &self.laws,
             edge_material: &self.map.edge_material,
             rest_length: &self.rest_length,
             masses: &self.masses,
@@ -332,16 +337,15 @@ impl Forces<'_> {
             let (i, j) = (3 * i as usize, 3 * j as usize);
             let d = DVec3::from_slice(&x[j..j + 3]) - DVec3::from_slice(&x[i..i + 3]);
             let len = d.length();
-            let dir = d / len;
+            let inv_len = 1.0 / len;
+            let dir = d * inv_len;
             let len_rate =
                 (DVec3::from_slice(&v[j..j + 3]) - DVec3::from_slice(&v[i..i + 3])).dot(dir);
-            let m = &self.materials[self.edge_material[e] as usize];
-            let l0 = self.rest_length[e];
-            let r = m
-                .element(l0)
-                .respond(m.rest_ratio * l0, len, len_rate, ratios[e]);
-            *force = dir * r.tension;
-            *rate = r.ratio_rate;
+            let law = &self.laws[self.edge_material[e] as usize];
+            let (tension, ratio_rate) =
+                law.respond(self.rest_length[e], len, inv_len, len_rate, ratios[e]);
+            *force = dir * tension;
+            *rate = ratio_rate;
         };
         // Node pass: sum the edge forces (fixed order: deterministic in parallel too).
         let node = |i: usize, edge_force: &[DVec3], dx: &mut [f64], dv: &mut [f64]| {

@@ -50,6 +50,14 @@ pub enum RheologyError {
         /// The selection error.
         source: SelectionError,
     },
+    /// A material region covers no tet.
+    #[error("material region {region} covers no tet: {why}")]
+    EmptyRegion {
+        /// Index of the region.
+        region: usize,
+        /// Why (what it selected).
+        why: String,
+    },
     /// The generated specimen mesh is invalid.
     #[error("specimen mesh: {0}")]
     Mesh(#[from] MeshError),

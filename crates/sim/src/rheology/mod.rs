@@ -11,6 +11,7 @@
 mod body;
 mod closed_form;
 mod damper;
+mod edge_law;
 mod element;
 mod error;
 mod indenter;

@@ -44,7 +44,9 @@ impl MaterialMap {
 
     /// `default` everywhere, then each region in order; a later region wins. An edge takes
     /// the material of the latest region among the tets that contain it, so an interface
-    /// edge belongs to the region listed last.
+    /// edge belongs to the region listed last. A region that covers no tet (a node
+    /// selection with no tet wholly inside it, an empty tet list) is an error: it is
+    /// almost certainly a wrong coordinate or unit.
     pub fn from_regions(
         mesh: &TetMesh,
         edges: &EdgeList,
@@ -79,13 +81,30 @@ impl MaterialMap {
                     for &n in &picked {
                         inside[n as usize] = true;
                     }
+                    let mut covered = 0;
                     for (t, tet) in mesh.tets.iter().enumerate() {
                         if tet.iter().all(|&n| inside[n as usize]) {
                             tet_priority[t] = r + 1;
+                            covered += 1;
                         }
+                    }
+                    if covered == 0 {
+                        return Err(RheologyError::EmptyRegion {
+                            region: r,
+                            why: format!(
+                                "its {} selected nodes include all four nodes of no tet",
+                                picked.len()
+                            ),
+                        });
                     }
                 }
                 RegionShape::Tets(list) => {
+                    if list.is_empty() {
+                        return Err(RheologyError::EmptyRegion {
+                            region: r,
+                            why: "its tet list is empty".into(),
+                        });
+                    }
                     for &t in list {
                         if t as usize >= mesh.tet_count() {
                             return Err(RheologyError::Selection {
@@ -202,5 +221,30 @@ mod tests {
         ));
         let e = MaterialMap::from_regions(&mesh, &edges, 0, &[tets(vec![999], 1)], 2);
         assert!(e.unwrap_err().to_string().contains("material region 0"));
+        let e =
+            MaterialMap::from_regions(&mesh, &edges, 0, &[tets(vec![0], 1), tets(vec![], 1)], 2);
+        assert!(matches!(
+            e,
+            Err(RheologyError::EmptyRegion { region: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn node_region_without_a_whole_tet_is_an_error() {
+        let (mesh, edges) = cube();
+        // The four bottom corners of one cell: nodes picked, but no tet has all four.
+        let sliver = MaterialRegion {
+            shape: RegionShape::Nodes(NodeSelection::Box {
+                min: Vec3::splat(-0.1),
+                max: Vec3::new(1.1, 1.1, 0.1),
+            }),
+            material: 1,
+        };
+        let e = MaterialMap::from_regions(&mesh, &edges, 0, &[sliver], 2).unwrap_err();
+        assert!(
+            matches!(e, RheologyError::EmptyRegion { region: 0, .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains("no tet"), "{e}");
     }
 }
