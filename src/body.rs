@@ -54,6 +54,14 @@ impl Body {
         }
     }
 
+    /// Where the tool will be at the end of the next frame.
+    pub fn move_tool(&mut self, to: incise_sim::contact::ToolPose) {
+        match self {
+            Body::Cpu(s) => s.move_tool(to),
+            Body::Gpu(g) => g.move_tool(to),
+        }
+    }
+
     /// The CPU solver, or the GPU solver's host mirror (positions, stress, cut state).
     pub fn solver(&self) -> &Solver {
         match self {

@@ -53,6 +53,12 @@ pub enum Command {
         /// report loop runs at the scene's frame rate in real time.
         #[arg(long, value_parser = positive_rate)]
         haptic_rate: Option<f64>,
+        /// Drive the scene's scalpel with this stroke file (RON timed poses) instead.
+        #[arg(long)]
+        stroke: Option<PathBuf>,
+        /// Record the scalpel's pose every frame to this stroke file.
+        #[arg(long)]
+        record_stroke: Option<PathBuf>,
     },
     /// Open the desktop preview: the scene in a window with a control panel.
     Preview {

@@ -38,6 +38,8 @@ fn default_command() -> Command {
                 screenshot_every: 0,
                 screenshot_size: ImageSize(960, 540),
                 haptic_rate: None,
+                stroke: None,
+                record_stroke: None,
             }
         }
     }
@@ -58,6 +60,8 @@ fn main() -> ExitCode {
             screenshot_every,
             screenshot_size,
             haptic_rate,
+            stroke,
+            record_stroke,
         } => run_scene(&RunOptions {
             scene,
             frames,
@@ -69,6 +73,8 @@ fn main() -> ExitCode {
             screenshot_every,
             screenshot_size,
             haptic_rate,
+            stroke,
+            record_stroke,
         })
         .map(|o| {
             println!("{}", o.report.summary());

@@ -21,6 +21,29 @@ pub struct FrameRecord {
     /// GPU kernel time of the frame (timestamps), ms; absent on the CPU or without them.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gpu_ms: Option<f64>,
+    /// Controller vibration amplitude 0..1 for this frame's tool force (the scalpel's
+    /// haptic curve); absent without a tool.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub haptic_amplitude: Option<f32>,
+}
+
+/// The scene's scalpel, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct ToolInfo {
+    /// Tool name.
+    pub name: String,
+    /// Contact spheres.
+    pub spheres: usize,
+    /// Of which on the cutting edge.
+    pub cutting_spheres: usize,
+    /// Sphere radius, m.
+    pub sphere_radius: f32,
+    /// Body boxes.
+    pub boxes: usize,
+    /// Friction coefficient.
+    pub friction: f32,
+    /// Duration of the stroke, s.
+    pub stroke_duration: f64,
 }
 
 /// A frame's statistics, by model (written flat into the frame's record).
@@ -92,6 +115,11 @@ pub struct Report {
     pub threads: usize,
     /// Device the solver ran on: "cpu" or the GPU adapter's name, backend and type.
     pub device: String,
+    /// The scalpel, when the scene has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tool: Option<ToolInfo>,
+    /// Tets released by the end of the run (mesh indices, ascending).
+    pub released_tets: Vec<u32>,
     /// Per-frame records.
     pub frames: Vec<FrameRecord>,
     /// Snapshot files written (relative to the report).

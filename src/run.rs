@@ -10,7 +10,7 @@ use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
 
 use crate::body::{Body, DeviceChoice};
 use crate::progress::Progress;
-use crate::report::{FrameData, FrameRecord, MaterialInfo, MeshInfo, Report};
+use crate::report::{FrameData, FrameRecord, MaterialInfo, MeshInfo, Report, ToolInfo};
 use crate::scene::{BuiltScene, build_scene, load_scene};
 use crate::screenshots::{ImageSize, Screenshots};
 
@@ -38,6 +38,11 @@ pub struct RunOptions {
     /// Run a mass-spring scene's local loop on its own thread at this rate, Hz (the
     /// haptic-rate option, PHYSICS.md §2.6); `None`: the ordinary frame loop.
     pub haptic_rate: Option<f64>,
+    /// Drive the scene's tool with this stroke file instead of the scene's stroke.
+    pub stroke: Option<PathBuf>,
+    /// Record the tool's pose at every frame to this stroke file (replayable with
+    /// `--stroke`, bit for bit).
+    pub record_stroke: Option<PathBuf>,
 }
 
 /// What a finished run produced.
@@ -69,6 +74,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         );
     }
     let BuiltScene {
+        tool,
         solver,
         skin,
         material,
@@ -77,6 +83,30 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         pinned_nodes,
         grabbed_nodes,
     } = build_scene(&scene, &opts.scene, opts.threads)?;
+    let mut tool = tool;
+    if let (Some(t), Some(path)) = (tool.as_mut(), &opts.stroke) {
+        t.stroke = incise_scalpel::load_stroke(path)?;
+    } else if opts.stroke.is_some() {
+        bail!("--stroke: {} has no tool to drive", opts.scene.display());
+    }
+    let mut solver = solver;
+    if let Some(t) = &tool {
+        solver.set_tool(t.contact.clone(), t.stroke.pose_at(0.0))?;
+    }
+    let haptic = incise_scalpel::HapticCurve::default();
+    let mut recorder = opts
+        .record_stroke
+        .as_ref()
+        .and(tool.as_ref())
+        .map(|t| -> Result<incise_scalpel::StrokeRecorder> {
+            let mut r = incise_scalpel::StrokeRecorder::new();
+            r.push(0.0, t.stroke.pose_at(0.0))?;
+            Ok(r)
+        })
+        .transpose()?;
+    if opts.record_stroke.is_some() && tool.is_none() {
+        bail!("--record-stroke: {} has no tool", opts.scene.display());
+    }
     let mut shots = match opts.screenshot_every {
         0 => None,
         _ => Some(Screenshots::new(
@@ -131,6 +161,16 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         solver: solver.params().clone(),
         threads,
         device: body.device(),
+        tool: tool.as_ref().map(|t| ToolInfo {
+            name: t.tool.name().to_string(),
+            spheres: t.contact.spheres.len(),
+            cutting_spheres: t.contact.spheres.iter().filter(|s| s.cutting).count(),
+            sphere_radius: t.contact.spheres.first().map_or(0.0, |s| s.radius),
+            boxes: t.contact.boxes.len(),
+            friction: t.contact.friction,
+            stroke_duration: t.stroke.duration(),
+        }),
+        released_tets: Vec::new(),
         frames: Vec::with_capacity(frames as usize),
         snapshots: Vec::new(),
         rheology: None,
@@ -146,20 +186,35 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     }
     let progress = (!opts.quiet).then(|| Progress::new(frames, 60));
     let mut failure = None;
+    let dt = body.solver().params().frame_dt as f64;
     for f in 0..frames {
         let t0 = Instant::now();
+        if let Some(t) = &tool {
+            let time = (f + 1) as f64 * dt;
+            let pose = t.stroke.pose_at(time);
+            body.move_tool(pose);
+            if let Some(r) = &mut recorder {
+                r.push(time, pose)?;
+            }
+        }
         match body.step_frame() {
             Ok(stats) => {
                 let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
                 if let Some(p) = &progress {
                     p.frame(f, || {
                         format!(
-                            "max σvM {:.0} Pa, released {}",
-                            stats.max_von_mises, stats.released_total
+                            "max σvM {:.0} Pa, released {}, tool {:.2} N",
+                            stats.max_von_mises,
+                            stats.released_total,
+                            stats.tool_force.length()
                         )
                     });
                 }
+                let haptic_amplitude = tool
+                    .as_ref()
+                    .map(|_| haptic.amplitude(stats.tool_force.length()));
                 report.frames.push(FrameRecord {
+                    haptic_amplitude,
                     stats: FrameData::Xpbd(stats),
                     wall_ms,
                     gpu_ms: body.gpu_frame_ms(),
@@ -194,6 +249,13 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     }
     .into();
     report.error = failure.as_ref().map(|e| e.to_string());
+    let cut = body.solver().cut();
+    report.released_tets = (0..body.solver().mesh().tet_count() as u32)
+        .filter(|&t| !cut.is_live(t as usize))
+        .collect();
+    if let (Some(r), Some(path)) = (recorder, &opts.record_stroke) {
+        r.finish()?.save(path)?;
+    }
     report.write(&report_path)?;
     if let Some(e) = failure {
         bail!(

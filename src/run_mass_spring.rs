@@ -73,6 +73,8 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
         .unwrap_or_else(|| (scene.duration as f64 / frame_dt).round().max(1.0) as u64);
     let lame = material.lame();
     let mut report = Report {
+        tool: None,
+        released_tets: Vec::new(),
         scene: scene.name.clone(),
         scene_file: opts.scene.display().to_string(),
         model: "mass-spring".into(),
@@ -195,6 +197,7 @@ fn run_frames(
             .map(|t| model.current_volume(t))
             .sum();
         report.frames.push(FrameRecord {
+            haptic_amplitude: None,
             stats: FrameData::Edges(EdgeFrameStats {
                 frame: f,
                 sim_time: model.time(),
@@ -269,6 +272,7 @@ fn run_haptic(
         let force = latest.tool_force;
         max_force = max_force.max(force.length());
         report.frames.push(FrameRecord {
+            haptic_amplitude: None,
             stats: FrameData::Edges(EdgeFrameStats {
                 frame: f,
                 sim_time: latest.sim_time,

@@ -141,6 +141,8 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
         .unwrap_or_else(|| (scene.duration as f64 / frame_dt).round().max(1.0) as u64);
     let limit = body.stability();
     let mut report = Report {
+        tool: None,
+        released_tets: Vec::new(),
         scene: scene.name.clone(),
         scene_file: opts.scene.display().to_string(),
         model: "rheology".into(),
@@ -195,6 +197,7 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
         dent = rest[probe].z as f64 - positions[probe].z;
         max_dent = max_dent.max(dent);
         report.frames.push(FrameRecord {
+            haptic_amplitude: None,
             stats: FrameData::Edges(EdgeFrameStats {
                 frame: f,
                 sim_time: body.time(),

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result, anyhow, bail};
 use incise_sim::grab::Grab;
 use incise_sim::skin::Skin;
 use incise_sim::{Material, MeshBuildReport, RawMesh, Solver, TetMesh, TriSurface, generate, io};
@@ -25,6 +25,19 @@ pub struct BuiltScene {
     pub pinned_nodes: usize,
     /// Grabbed node count.
     pub grabbed_nodes: usize,
+    /// The scalpel and its stroke, when the scene has one (attached to the solver at the
+    /// stroke's first pose).
+    pub tool: Option<SceneTool>,
+}
+
+/// A scene's scalpel as loaded.
+pub struct SceneTool {
+    /// The tool model (geometry, render mesh).
+    pub tool: incise_scalpel::Tool,
+    /// What the solver sees of it (spheres sized for this mesh, body boxes).
+    pub contact: incise_sim::contact::ContactTool,
+    /// The stroke that drives it.
+    pub stroke: incise_scalpel::Stroke,
 }
 
 /// Build `scene` (read from `scene_path`, whose folder anchors relative paths); presets
@@ -105,7 +118,34 @@ pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> 
             start_time: g.start,
         });
     }
+    let tool = match (&scene.tool, &scene.stroke) {
+        (None, None) => None,
+        (Some(_), None) => bail!(
+            "{}: stroke: a scene with a tool needs a stroke (File(\"...\") or Incision(...))",
+            scene_path.display()
+        ),
+        (None, Some(_)) => bail!(
+            "{}: tool: a stroke needs a tool, e.g. tool: Some((file: \"tools/scalpel_10.ron\"))",
+            scene_path.display()
+        ),
+        (Some(spec), Some(stroke)) => {
+            let (tool, stroke) = super::tool::load(spec, stroke, scene_path)?;
+            let mut contact = tool.contact_tool(solver.mesh().mean_edge_length());
+            if spec.dull {
+                contact = contact.dulled();
+            }
+            solver
+                .set_tool(contact.clone(), stroke.pose_at(0.0))
+                .with_context(|| format!("{}: tool", scene_path.display()))?;
+            Some(SceneTool {
+                tool,
+                contact,
+                stroke,
+            })
+        }
+    };
     Ok(BuiltScene {
+        tool,
         solver,
         skin,
         material,

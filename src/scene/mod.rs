@@ -4,14 +4,16 @@
 mod build;
 mod load;
 mod model;
+mod tool;
 
 pub use build::raw_mesh;
-pub use build::{BuiltScene, build_scene};
+pub use build::{BuiltScene, SceneTool, build_scene};
 pub use load::{SceneError, load_materials, load_scene, locate, parse_scene};
 pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
     StrokeSpec,
 };
+pub use tool::{IncisionSpec, ToolSpec, ToolStroke};
 
 use glam::{UVec3, Vec3};
 use incise_sim::Material;
@@ -54,6 +56,12 @@ pub struct Scene {
     /// `Rheology(...)` (PHYSICS.md §3).
     #[serde(default)]
     pub model: ModelChoice,
+    /// The scalpel (PHYSICS.md §1.5): `Some((file: "tools/scalpel_10.ron"))`.
+    #[serde(default)]
+    pub tool: Option<ToolSpec>,
+    /// What drives the scalpel: `Some(File("strokes/x.ron"))` or `Some(Incision(...))`.
+    #[serde(default)]
+    pub stroke: Option<ToolStroke>,
 }
 
 /// Where a tet mesh comes from.
