@@ -157,7 +157,7 @@ impl Tool {
         self.sharp
     }
 
-    /// The same tool with a dull edge: its contact tool has no edge spheres, only the body.
+    /// The same tool with a dull edge: its edge spheres push but never cut.
     pub fn dull(&self) -> Tool {
         Tool {
             sharp: false,
@@ -194,7 +194,7 @@ impl Tool {
     /// along the edge by arc length (both ends included; one sphere sits mid-edge), each
     /// centred one radius inside the blade along the edge's in-plane normal so that it is
     /// tangent to the edge line from inside, then the body boxes (never cutting). A dull
-    /// tool has no edge spheres.
+    /// tool's edge spheres push but do not cut.
     ///
     /// # Panics
     /// As [`Tool::edge_spheres_for`].
