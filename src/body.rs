@@ -54,6 +54,18 @@ impl Body {
         }
     }
 
+    /// Attach `tool` at `pose`, replacing any tool (see `Solver::set_tool`).
+    pub fn set_tool(
+        &mut self,
+        tool: incise_sim::contact::ContactTool,
+        pose: incise_sim::contact::ToolPose,
+    ) -> Result<(), SolverError> {
+        match self {
+            Body::Cpu(s) => s.set_tool(tool, pose),
+            Body::Gpu(g) => g.set_tool(tool, pose),
+        }
+    }
+
     /// Where the tool will be at the end of the next frame.
     pub fn move_tool(&mut self, to: incise_sim::contact::ToolPose) {
         match self {

@@ -11,7 +11,7 @@ use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
 use crate::body::{Body, DeviceChoice};
 use crate::progress::Progress;
 use crate::report::{FrameData, FrameRecord, MaterialInfo, MeshInfo, Report, ToolInfo};
-use crate::scene::{BuiltScene, build_scene, load_scene};
+use crate::scene::{BuiltScene, ToolDriver, build_scene_driven, load_scene};
 use crate::screenshots::{ImageSize, Screenshots};
 
 /// Options of `incise run`.
@@ -73,6 +73,12 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
             opts.scene.display()
         );
     }
+    // A recorded stroke is a hand's: the scene gets the tool and cut zone the preview
+    // gave it (scene/hand_tool.rs), so the replay is the same physics.
+    let driver = match opts.stroke {
+        Some(_) => ToolDriver::Hand,
+        None => ToolDriver::Scene,
+    };
     let BuiltScene {
         tool,
         solver,
@@ -82,25 +88,25 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         mesh_report,
         pinned_nodes,
         grabbed_nodes,
-    } = build_scene(&scene, &opts.scene, opts.threads)?;
+    } = build_scene_driven(&scene, &opts.scene, opts.threads, driver)?;
     let mut tool = tool;
     if let (Some(t), Some(path)) = (tool.as_mut(), &opts.stroke) {
-        t.stroke = incise_scalpel::load_stroke(path)?;
-    } else if opts.stroke.is_some() {
-        bail!("--stroke: {} has no tool to drive", opts.scene.display());
+        t.stroke = Some(incise_scalpel::load_stroke(path)?);
     }
+    // The tool and the stroke that drives it this run.
+    let tool = tool.and_then(|t| t.stroke.clone().map(|s| (t, s)));
     let mut solver = solver;
-    if let Some(t) = &tool {
-        solver.set_tool(t.contact.clone(), t.stroke.pose_at(0.0))?;
+    if let Some((t, stroke)) = &tool {
+        solver.set_tool(t.contact.clone(), stroke.pose_at(0.0))?;
     }
     let haptic = incise_scalpel::HapticCurve::default();
     let mut recorder = opts
         .record_stroke
         .as_ref()
         .and(tool.as_ref())
-        .map(|t| -> Result<incise_scalpel::StrokeRecorder> {
+        .map(|(_, stroke)| -> Result<incise_scalpel::StrokeRecorder> {
             let mut r = incise_scalpel::StrokeRecorder::new();
-            r.push(0.0, t.stroke.pose_at(0.0))?;
+            r.push(0.0, stroke.pose_at(0.0))?;
             Ok(r)
         })
         .transpose()?;
@@ -109,13 +115,19 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     }
     let mut shots = match opts.screenshot_every {
         0 => None,
-        _ => Some(Screenshots::new(
-            None,
-            &solver,
-            &skin,
-            opts.screenshot_size,
-            Default::default(),
-        )?),
+        _ => {
+            let shots = Screenshots::new(
+                None,
+                &solver,
+                &skin,
+                opts.screenshot_size,
+                Default::default(),
+            )?;
+            Some(match &tool {
+                Some((t, _)) => shots.with_tool(&t.tool),
+                None => shots,
+            })
+        }
     };
     let quiet = opts.quiet;
     let mut body = Body::place(solver, opts.device, |m| {
@@ -161,14 +173,14 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         solver: solver.params().clone(),
         threads,
         device: body.device(),
-        tool: tool.as_ref().map(|t| ToolInfo {
+        tool: tool.as_ref().map(|(t, stroke)| ToolInfo {
             name: t.tool.name().to_string(),
             spheres: t.contact.spheres.len(),
             cutting_spheres: t.contact.spheres.iter().filter(|s| s.cutting).count(),
             sphere_radius: t.contact.spheres.first().map_or(0.0, |s| s.radius),
             boxes: t.contact.boxes.len(),
             friction: t.contact.friction,
-            stroke_duration: t.stroke.duration(),
+            stroke_duration: stroke.duration(),
         }),
         released_tets: Vec::new(),
         frames: Vec::with_capacity(frames as usize),
@@ -189,9 +201,9 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let dt = body.solver().params().frame_dt as f64;
     for f in 0..frames {
         let t0 = Instant::now();
-        if let Some(t) = &tool {
+        if let Some((_, stroke)) = &tool {
             let time = (f + 1) as f64 * dt;
-            let pose = t.stroke.pose_at(time);
+            let pose = stroke.pose_at(time);
             body.move_tool(pose);
             if let Some(r) = &mut recorder {
                 r.push(time, pose)?;

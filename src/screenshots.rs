@@ -53,6 +53,8 @@ pub enum OverlayArg {
     Wireframe,
     /// Pinned nodes.
     Pinned,
+    /// The scalpel's contact spheres at its pose.
+    ToolSpheres,
 }
 
 /// The overlay switches for a list of `--overlay` values.
@@ -61,7 +63,7 @@ pub fn overlays(list: &[OverlayArg]) -> Overlays {
         stress: list.contains(&OverlayArg::Stress),
         wireframe: list.contains(&OverlayArg::Wireframe),
         pinned: list.contains(&OverlayArg::Pinned),
-        tool_spheres: false,
+        tool_spheres: list.contains(&OverlayArg::ToolSpheres),
     }
 }
 
@@ -101,6 +103,8 @@ pub struct Screenshots {
     pinned: Vec<u32>,
     /// Whether a GPU body lives on this renderer's device.
     shared_device: bool,
+    /// Whether the solver's tool is drawn (its mesh given by [`Screenshots::with_tool`]).
+    draw_tool: bool,
 }
 
 impl Screenshots {
@@ -132,7 +136,18 @@ impl Screenshots {
             },
             pinned: pinned_nodes(solver),
             shared_device: false,
+            draw_tool: false,
         })
+    }
+
+    /// Draw `tool` (its own mesh) wherever the solver's tool is, with its contact spheres
+    /// when that overlay is on.
+    pub fn with_tool(mut self, tool: &incise_scalpel::Tool) -> Self {
+        self.offscreen
+            .renderer
+            .set_tool_mesh(&crate::tool_view::tool_mesh(tool));
+        self.draw_tool = true;
+        self
     }
 
     /// Declare that GPU bodies given to [`Screenshots::save`] live on this renderer's device.
@@ -144,6 +159,9 @@ impl Screenshots {
     /// Render `body` now and write the PNG to `path`.
     pub fn save(&mut self, body: &Body, path: &Path) -> Result<()> {
         let solver = body.solver();
+        if self.draw_tool {
+            self.settings.tool = crate::tool_view::tool_state(solver);
+        }
         let mut state = BodyState::of_solver(solver, &self.pinned);
         if let (Body::Gpu(g), true) = (body, self.shared_device) {
             state.device_positions = Some(g.position_buffer());
@@ -178,8 +196,17 @@ pub fn render_frame(
         overlays(overlay),
     )?
     .with_shared_device();
+    if let Some(t) = &built.tool {
+        shots = shots.with_tool(&t.tool);
+    }
+    let stroke = built.tool.as_ref().and_then(|t| t.stroke.clone());
+    let dt = built.solver.params().frame_dt as f64;
     let mut body = place_on(built.solver, device, &dev)?;
     for f in 0..frame {
+        // The scene's stroke moves the tool as in `incise run`.
+        if let Some(s) = &stroke {
+            body.move_tool(s.pose_at((f + 1) as f64 * dt));
+        }
         body.step_frame()
             .with_context(|| format!("{}: frame {f}", scene_path.display()))?;
     }

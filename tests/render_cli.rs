@@ -128,3 +128,93 @@ fn run_writes_a_screenshot_every_k_frames() {
     assert!(foreground(&first) > 100);
     assert_ne!(first, last, "the bar is pulled between the two screenshots");
 }
+
+/// The scalpel's own mesh is drawn at its pose (and its contact spheres with the
+/// overlay): the same scene rendered with and without its tool differs where the blade
+/// projects, and there the picture is steel grey.
+#[test]
+fn render_draws_the_scalpel_mesh_and_its_spheres() {
+    let dir = temp_dir("render-scalpel");
+    std::fs::create_dir_all(dir.join("tools")).unwrap();
+    std::fs::copy("config/materials.ron", dir.join("materials.ron")).unwrap();
+    std::fs::copy(
+        "config/tools/scalpel_10.ron",
+        dir.join("tools/scalpel_10.ron"),
+    )
+    .unwrap();
+    let with = std::fs::read_to_string("config/plate_cut.ron").unwrap();
+    let tool_at = with.find("    tool: Some(").unwrap();
+    let duration_at = with.find("    duration:").unwrap();
+    let without = format!("{}{}", &with[..tool_at], &with[duration_at..]);
+    let (with_path, without_path) = (dir.join("with.ron"), dir.join("without.ron"));
+    std::fs::write(&with_path, &with).unwrap();
+    std::fs::write(&without_path, &without).unwrap();
+    let render = |scene: &std::path::Path, png: &str, overlay: Option<&str>| {
+        let out = dir.join(png);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--frame",
+            "0",
+            out.to_str().unwrap(),
+            "--size",
+            "320x180",
+            "--device",
+            "cpu",
+        ];
+        if let Some(o) = overlay {
+            args.extend(["--overlay", o]);
+        }
+        let o = incise(&args);
+        (!no_adapter(&o)).then(|| {
+            assert!(o.status.success(), "stderr: {}", text(&o.stderr));
+            RgbaImage::load_png(&out).unwrap()
+        })
+    };
+    let Some(tool) = render(&with_path, "with.png", None) else {
+        return;
+    };
+    let plain = render(&without_path, "without.png", None).unwrap();
+    let spheres = render(&with_path, "spheres.png", Some("tool-spheres")).unwrap();
+    // Where the blade is: 15 mm along its spine from the tip, on the edge-spine midline,
+    // at the stroke's first pose, through the renderer's default camera.
+    let scene = incise::scene::load_scene(&with_path).unwrap();
+    let built = incise::scene::build_scene(&scene, &with_path, None).unwrap();
+    let pose = built
+        .tool
+        .as_ref()
+        .unwrap()
+        .stroke
+        .as_ref()
+        .unwrap()
+        .pose_at(0.0);
+    let mid = pose.transform_point(glam::Vec3::new(0.015, 0.0, 0.0));
+    let view = incise::screenshots::default_camera(built.solver.mesh()).view(320.0 / 180.0);
+    let px = view.project(mid, glam::Vec2::new(320.0, 180.0)).unwrap();
+    let (x, y) = (px.x as u32, px.y as u32);
+    let (a, b) = (tool.get(x, y), plain.get(x, y));
+    assert_ne!(a[..3], b[..3], "no blade at ({x}, {y})");
+    let grey = a[..3].iter().max().unwrap() - a[..3].iter().min().unwrap();
+    assert!(grey < 30 && a[0] > 100, "not steel at ({x}, {y}): {a:?}");
+    let differ = |p: &RgbaImage, q: &RgbaImage| {
+        p.pixels
+            .chunks_exact(4)
+            .zip(q.pixels.chunks_exact(4))
+            .filter(|(u, v)| u[..3] != v[..3])
+            .count()
+    };
+    assert!(differ(&tool, &plain) > 500, "the blade covers too little");
+    // The contact spheres overlay adds blue spheres along the edge.
+    let blue = |img: &RgbaImage| {
+        img.pixels
+            .chunks_exact(4)
+            .filter(|p| p[2] as i32 > p[0] as i32 + 60)
+            .count()
+    };
+    assert!(
+        blue(&spheres) > blue(&tool) + 50,
+        "{} vs {}",
+        blue(&spheres),
+        blue(&tool)
+    );
+}

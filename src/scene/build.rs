@@ -26,7 +26,8 @@ pub struct BuiltScene {
     /// Grabbed node count.
     pub grabbed_nodes: usize,
     /// The scalpel and its stroke, when the scene has one (attached to the solver at the
-    /// stroke's first pose).
+    /// stroke's first pose); with [`ToolDriver::Hand`] always (the built-in blade when the
+    /// scene names none, not attached: the hand places it).
     pub tool: Option<SceneTool>,
 }
 
@@ -36,13 +37,34 @@ pub struct SceneTool {
     pub tool: incise_scalpel::Tool,
     /// What the solver sees of it (spheres sized for this mesh, body boxes).
     pub contact: incise_sim::contact::ContactTool,
-    /// The stroke that drives it.
-    pub stroke: incise_scalpel::Stroke,
+    /// The scene's stroke (`None`: a hand-driven tool the scene does not script).
+    pub stroke: Option<incise_scalpel::Stroke>,
+}
+
+/// Who moves a scene's scalpel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToolDriver {
+    /// The scene's own stroke (or no tool at all).
+    Scene,
+    /// A hand: the preview's mouse or a recorded stroke. Every scene gets a tool (the
+    /// built-in No. 10 when it names none) and a cutting scene without a cut zone gets one
+    /// along the edge (see `hand_tool`).
+    Hand,
 }
 
 /// Build `scene` (read from `scene_path`, whose folder anchors relative paths); presets
 /// come from `materials.ron` beside the scene file.
 pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> Result<BuiltScene> {
+    build_scene_driven(scene, scene_path, threads, ToolDriver::Scene)
+}
+
+/// [`build_scene`] for a tool moved by `driver`.
+pub fn build_scene_driven(
+    scene: &Scene,
+    scene_path: &Path,
+    threads: Option<usize>,
+    driver: ToolDriver,
+) -> Result<BuiltScene> {
     let model = match &scene.model {
         super::ModelChoice::Xpbd => None,
         super::ModelChoice::MassSpring(_) => Some("MassSpring"),
@@ -93,6 +115,9 @@ pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> 
     if let Some(t) = threads {
         params.threads = t;
     }
+    if driver == ToolDriver::Hand {
+        super::hand_tool::edge_cut_zone(&mut params, mesh.mean_edge_length());
+    }
     let rest = mesh.rest_positions.clone();
     let mut solver =
         Solver::new(mesh, material, params).with_context(|| scene_path.display().to_string())?;
@@ -119,6 +144,15 @@ pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> 
         });
     }
     let tool = match (&scene.tool, &scene.stroke) {
+        (None, None) if driver == ToolDriver::Hand => {
+            let tool = super::hand_tool::default_tool()?;
+            let contact = tool.contact_tool(solver.mesh().mean_edge_length());
+            Some(SceneTool {
+                tool,
+                contact,
+                stroke: None,
+            })
+        }
         (None, None) => None,
         (Some(_), None) => bail!(
             "{}: stroke: a scene with a tool needs a stroke (File(\"...\") or Incision(...))",
@@ -140,7 +174,7 @@ pub fn build_scene(scene: &Scene, scene_path: &Path, threads: Option<usize>) -> 
             Some(SceneTool {
                 tool,
                 contact,
-                stroke,
+                stroke: Some(stroke),
             })
         }
     };

@@ -2,12 +2,13 @@
 //! grabs, solver settings, cutting, duration).
 
 mod build;
+pub mod hand_tool;
 mod load;
 mod model;
 mod tool;
 
 pub use build::raw_mesh;
-pub use build::{BuiltScene, SceneTool, build_scene};
+pub use build::{BuiltScene, SceneTool, ToolDriver, build_scene, build_scene_driven};
 pub use load::{SceneError, load_materials, load_scene, locate, parse_scene};
 pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,

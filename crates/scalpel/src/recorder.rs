@@ -55,6 +55,12 @@ impl StrokeRecorder {
         Ok(())
     }
 
+    /// The last sample as stored (rotation normalised): the pose a caller drives the
+    /// solver with so that a replay of the finished stroke sees the same bits.
+    pub fn last(&self) -> Option<PoseKey> {
+        self.keys.last().copied()
+    }
+
     /// Number of samples so far.
     pub fn len(&self) -> usize {
         self.keys.len()

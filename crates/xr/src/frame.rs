@@ -84,7 +84,9 @@ pub const MATERIAL_IDS: [(&str, [u8; 3]); 7] = [
 /// The scalpel (or stand-in) as drawn.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ToolState {
-    /// Tool mesh placement (rigid: rotation and translation); `None` hides the mesh.
+    /// Tool mesh placement (rigid: rotation and translation), tool frame → world; `None`
+    /// hides the mesh. The mesh is the stand-in blade unless
+    /// [`crate::Renderer::set_tool_mesh`] gave another.
     pub transform: Option<Mat4>,
     /// Contact spheres (centre, radius), m: drawn by the tool-spheres overlay.
     pub spheres: Vec<(Vec3, f32)>,

@@ -119,6 +119,12 @@ impl Renderer {
         }
     }
 
+    /// Draw `mesh` (tool frame, placed by [`crate::frame::ToolState::transform`]) as the
+    /// tool from now on, instead of the stand-in blade.
+    pub fn set_tool_mesh(&mut self, mesh: &ToolMesh) {
+        self.tool = MeshBuffers::new(&self.device, mesh);
+    }
+
     /// The colour format this renderer draws.
     pub fn format(&self) -> wgpu::TextureFormat {
         self.format

@@ -1,5 +1,6 @@
-//! Meshes drawn for tools: a simple scalpel (until the scalpel issue brings its own) and
-//! the unit sphere that marker instances scale.
+//! Meshes drawn for tools: any closed triangle mesh the application hands over (the
+//! scalpel's own, flat-shaded by [`ToolMesh::from_triangles`]), the simple stand-in blade
+//! drawn until it does, and the unit sphere that marker instances scale.
 
 use glam::Vec3;
 
@@ -15,6 +16,19 @@ pub struct ToolMesh {
 }
 
 impl ToolMesh {
+    /// A flat-shaded mesh from plain vertices and counter-clockwise-outward triangles in
+    /// the tool's own frame (m): each triangle gets its own three vertices and its face
+    /// normal. Triangles naming a vertex that does not exist are skipped.
+    pub fn from_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> ToolMesh {
+        let mut m = ToolMesh::default();
+        for t in triangles {
+            if let [Some(&a), Some(&b), Some(&c)] = t.map(|i| positions.get(i as usize)) {
+                m.add_triangle([a, b, c]);
+            }
+        }
+        m
+    }
+
     /// A simple scalpel: the blade in the x-z plane with its tip at the origin and its
     /// cutting edge running back along −x just above it, the handle rising behind. Its
     /// contact point is the origin. Flat-shaded.
@@ -207,5 +221,24 @@ mod tests {
             .map(|p| p.z)
             .fold(f32::INFINITY, f32::min);
         assert!(lowest.abs() < 1e-6, "{lowest}");
+    }
+
+    #[test]
+    fn an_arbitrary_mesh_is_flat_shaded_per_face() {
+        // A unit right tetrahedron, wound outward; one bad triangle is skipped.
+        let p = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let tris = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 1, 9]];
+        let m = ToolMesh::from_triangles(&p, &tris);
+        assert_eq!(m.indices.len(), 4);
+        assert_eq!(m.positions.len(), 12);
+        // The face x + y + z = 1 has normal (1, 1, 1)/√3 on all three of its vertices.
+        let n = Vec3::ONE.normalize();
+        assert!(m.normals[9..12].iter().all(|v| (*v - n).length() < 1e-6));
+        assert!(
+            m.normals[0..3]
+                .iter()
+                .all(|v| (*v + Vec3::Z).length() < 1e-6)
+        );
+        assert!((signed_volume(&m) - 1.0 / 6.0).abs() < 1e-6);
     }
 }
