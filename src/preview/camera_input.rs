@@ -1,5 +1,5 @@
-//! Orbit, pan and zoom from the mouse and keyboard: left- or right-drag orbits,
-//! middle-drag or shift+drag pans, the wheel zooms, arrow keys orbit, +/- zoom, R resets
+//! Orbit, pan and zoom from the mouse and keyboard: right-drag orbits (the left button
+//! is the scalpel's), middle-drag or shift+right-drag pans, the wheel zooms, arrow keys orbit, +/- zoom, R resets
 //! the view, F (or F11) toggles fullscreen, Space plays/pauses, Escape quits.
 
 use incise_xr::Camera;
@@ -33,11 +33,16 @@ impl CameraInput {
     pub fn button(&mut self, button: MouseButton, state: ElementState) -> bool {
         let down = state == ElementState::Pressed;
         match button {
-            MouseButton::Left | MouseButton::Right => self.orbiting = down,
+            MouseButton::Right => self.orbiting = down,
             MouseButton::Middle => self.panning = down,
             _ => return false,
         }
         true
+    }
+
+    /// Whether a drag is moving the camera now.
+    pub fn dragging(&self) -> bool {
+        self.orbiting || self.panning
     }
 
     /// Shift is held (turns orbit-drags into pans).

@@ -1,11 +1,15 @@
 //! `incise preview`: the desktop window (winit) with the incise-xr renderer, an egui
-//! side panel and orbit/pan/zoom. `--frames N` renders N frames and exits (for tests and
-//! scripts); `--screenshot FILE` saves the window's last frame.
+//! side panel, orbit/pan/zoom and the mouse scalpel (left-drag cuts, see
+//! [`scalpel_input`]). `--frames N` renders N frames and exits (for tests and scripts);
+//! `--screenshot FILE` saves the window's last frame.
 
 mod camera_input;
 pub mod display;
 mod frame_times;
+pub mod hand_tool;
 mod panel;
+pub mod pick;
+pub mod scalpel_input;
 mod session;
 mod window_gpu;
 
@@ -14,9 +18,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
-use incise_xr::{BodyState, Camera, RenderSettings, Renderer};
+use incise_xr::{BodyState, Camera, RenderSettings, Renderer, View};
 use winit::application::ApplicationHandler;
-use winit::event::{ElementState, WindowEvent};
+use winit::event::{ElementState, MouseButton, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Fullscreen, Window, WindowId};
 
@@ -29,9 +33,9 @@ fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
     cam.zoom(1.3);
     cam
 }
-use camera_input::{CameraInput, KeyAction};
+use camera_input::{CameraInput, KeyAction, wheel_steps};
 use frame_times::{FrameTime, FrameTimes};
-use panel::{Action, Panel, PanelInfo};
+use panel::{Action, Panel, PanelInfo, ScalpelInfo};
 use session::{Session, scene_files};
 use window_gpu::{PanelFrame, WindowGpu};
 
@@ -89,6 +93,14 @@ struct Live {
     last_frame: Instant,
     frames_drawn: u64,
     capture_next: bool,
+    /// The last drawn view and its size in pixels (for cursor rays).
+    view: Option<(View, (u32, u32))>,
+    /// Cursor position, physical pixels.
+    cursor: Option<(f64, f64)>,
+    /// Whether the left button holds the blade in the tissue.
+    left_down: bool,
+    /// Ctrl is held (the wheel sets the depth).
+    ctrl: bool,
 }
 
 impl ApplicationHandler for App {
@@ -122,19 +134,32 @@ impl ApplicationHandler for App {
                     event_loop.exit();
                 }
             },
-            WindowEvent::ModifiersChanged(m) => live.input.set_shift(m.state().shift_key()),
+            WindowEvent::ModifiersChanged(m) => {
+                live.input.set_shift(m.state().shift_key());
+                live.ctrl = m.state().control_key();
+            }
             WindowEvent::MouseInput { state, button, .. }
                 if !consumed || state == ElementState::Released =>
             {
-                live.input.button(button, state);
+                if button == MouseButton::Left {
+                    live.scalpel_button(state);
+                } else {
+                    live.input.button(button, state);
+                }
             }
             WindowEvent::CursorMoved { position, .. } => {
                 let h = live.window.inner_size().height as f64;
                 live.input
                     .cursor(&mut live.camera, position.x, position.y, h);
+                live.cursor = Some((position.x, position.y));
+                live.scalpel_cursor();
             }
             WindowEvent::MouseWheel { delta, .. } if !consumed => {
-                live.input.wheel(&mut live.camera, delta);
+                if live.left_down || live.ctrl {
+                    live.session.hand.input.wheel(wheel_steps(delta));
+                } else {
+                    live.input.wheel(&mut live.camera, delta);
+                }
             }
             WindowEvent::KeyboardInput { event, .. }
                 if !consumed && event.state == ElementState::Pressed =>
@@ -187,13 +212,14 @@ impl Live {
             d => d,
         };
         let session = Session::load(&opts.scene, device, &gpu.dev)?;
-        let renderer = Renderer::new(
+        let mut renderer = Renderer::new(
             &gpu.dev.device,
             &gpu.dev.queue,
             gpu.format(),
             session.body.solver().mesh(),
             &session.skin,
         );
+        renderer.set_tool_mesh(&crate::tool_view::tool_mesh(&session.hand.tool));
         let egui = egui::Context::default();
         let egui_winit = egui_winit::State::new(
             egui.clone(),
@@ -217,6 +243,7 @@ impl Live {
                 device,
                 overlays: Default::default(),
                 message: String::new(),
+                stroke_file: "out/preview_stroke.ron".into(),
             },
             window,
             gpu,
@@ -231,7 +258,54 @@ impl Live {
             last_frame: Instant::now(),
             frames_drawn: 0,
             capture_next: false,
+            view: None,
+            cursor: None,
+            left_down: false,
+            ctrl: false,
         })
+    }
+
+    /// The world ray through the cursor, if a frame has been drawn.
+    fn cursor_ray(&self) -> Option<(glam::Vec3, glam::Vec3)> {
+        let ((view, (w, h)), (x, y)) = (self.view.as_ref()?, self.cursor?);
+        Some(view.ray(
+            glam::Vec2::new(x as f32, y as f32),
+            glam::Vec2::new(*w as f32, *h as f32),
+        ))
+    }
+
+    /// The left button: down on the tissue starts a cut there (the mouse takes the blade
+    /// from the scene's stroke), up lifts the blade.
+    fn scalpel_button(&mut self, state: ElementState) {
+        if state == ElementState::Released {
+            self.session.hand.input.release();
+            self.left_down = false;
+            return;
+        }
+        let Some((o, d)) = self.cursor_ray() else {
+            return;
+        };
+        let solver = self.session.body.solver();
+        let hit = pick::pick_tissue(o, d, solver.mesh(), solver.cut(), solver.positions());
+        let (frame, dt) = (solver.frame(), solver.params().frame_dt as f64);
+        if hit.is_some() {
+            self.session.hand.take_mouse(frame, dt);
+        }
+        self.left_down = self.session.hand.input.press(hit);
+        if !self.left_down {
+            self.panel.message = "no tissue under the cursor".into();
+        }
+    }
+
+    /// The cursor moved: the blade follows on its plane (not while the camera is dragged,
+    /// nor over the panel unless cutting).
+    fn scalpel_cursor(&mut self) {
+        if self.input.dragging() || (!self.left_down && self.egui.is_pointer_over_egui()) {
+            return;
+        }
+        if let Some((o, d)) = self.cursor_ray() {
+            self.session.hand.input.cursor(o, d);
+        }
     }
 
     /// One frame; `Ok(false)` when the preview should close.
@@ -259,6 +333,7 @@ impl Live {
             stress_max: stress_scale(solver),
             device: self.session.body.device(),
             times: &self.times,
+            scalpel: ScalpelInfo::of(&self.session.hand),
         };
         let input = self.egui_winit.take_egui_input(&self.window);
         let panel = &mut self.panel;
@@ -282,6 +357,7 @@ impl Live {
         let settings = RenderSettings {
             overlays: self.panel.overlays,
             stress_max: stress_scale(solver),
+            tool: crate::tool_view::tool_state(solver),
             ..RenderSettings::default()
         };
         let (w, h) = self.gpu.size();
@@ -289,6 +365,7 @@ impl Live {
         // Centre the scene in the part of the window the panel leaves free.
         let shift = panel_points * out.pixels_per_point / w.max(1) as f32;
         view.proj = glam::Mat4::from_translation(glam::Vec3::new(shift, 0.0, 0.0)) * view.proj;
+        self.view = Some((view, (w, h)));
         let drawn = self.gpu.draw(
             &mut self.renderer,
             &state,
@@ -343,6 +420,10 @@ impl Live {
 
     fn act(&mut self, action: Action) -> Result<()> {
         let dev = &self.gpu.dev;
+        let restarts = matches!(action, Action::Load(_) | Action::Reset | Action::Apply(..));
+        if restarts && self.session.hand.abort_recording() {
+            self.panel.message = "recording dropped: the scene changed under it".into();
+        }
         let result = match action {
             Action::Load(path) => Session::load(&path, self.session.device, dev).map(|s| {
                 self.renderer = Renderer::new(
@@ -352,6 +433,8 @@ impl Live {
                     s.body.solver().mesh(),
                     &s.skin,
                 );
+                self.renderer
+                    .set_tool_mesh(&crate::tool_view::tool_mesh(&s.hand.tool));
                 self.home = preview_camera(s.body.solver().mesh());
                 self.camera = self.home;
                 self.panel.draft = s.params;
@@ -377,6 +460,34 @@ impl Live {
                 Ok(String::new())
             }
             Action::SaveVtu => self.save_vtu(),
+            Action::SetDepth(d) => {
+                self.session.hand.input.set_depth(d);
+                Ok(String::new())
+            }
+            Action::PlayStroke(on) => {
+                let s = self.session.body.solver();
+                let (frame, dt) = (s.frame(), s.params().frame_dt as f64);
+                if on {
+                    self.session.hand.play_stroke = self.session.hand.has_stroke();
+                } else {
+                    self.session.hand.take_mouse(frame, dt);
+                }
+                Ok(String::new())
+            }
+            Action::StartRecording => self.session.start_recording(dev).map(|()| {
+                self.panel.draft = self.session.params;
+                "recording from frame 0 (scene reloaded)".into()
+            }),
+            Action::StopRecording(path) => self.session.hand.stop_recording(&path).map(|r| {
+                format!(
+                    "saved {} poses to {}; replay: incise run {} --stroke {} --frames {}",
+                    r.poses,
+                    path.display(),
+                    self.session.path.display(),
+                    path.display(),
+                    r.frames
+                )
+            }),
         };
         match result {
             Ok(msg) if !msg.is_empty() => self.panel.message = msg,

@@ -1,6 +1,7 @@
 //! The egui side panel: scene picker, play/pause/step/reset, live material and solver
-//! settings, device, overlays with the stress legend, the frame-time graph, and buttons
-//! for screenshots and `.vtu` snapshots. It only reports what the user asked for.
+//! settings, device, overlays with the stress legend, the frame-time graph, the scalpel
+//! (depth, force, haptic amplitude, stroke recording), and buttons for screenshots and
+//! `.vtu` snapshots. It only reports what the user asked for.
 
 use std::path::PathBuf;
 
@@ -29,6 +30,14 @@ pub enum Action {
     Screenshot,
     /// Save the body as a `.vtu`.
     SaveVtu,
+    /// Set the scalpel's cut depth, m.
+    SetDepth(f32),
+    /// Let the scene's stroke move the scalpel (true) or the mouse (false).
+    PlayStroke(bool),
+    /// Reload the scene and record the scalpel's poses from frame 0.
+    StartRecording,
+    /// Stop recording and save the stroke to this file.
+    StopRecording(PathBuf),
 }
 
 /// Panel state that persists between frames.
@@ -45,6 +54,41 @@ pub struct Panel {
     pub overlays: Overlays,
     /// Status line (last save, last error).
     pub message: String,
+    /// Where a recorded stroke is saved.
+    pub stroke_file: String,
+}
+
+/// What the panel shows of the scalpel.
+pub struct ScalpelInfo {
+    /// Tool name.
+    pub name: String,
+    /// Whether the left button holds the blade in the tissue.
+    pub cutting: bool,
+    /// Cut depth and its limit, m.
+    pub depth: (f32, f32),
+    /// Tissue force on the tool in the last frame, N.
+    pub force: f32,
+    /// Haptic amplitude for it, 0..1.
+    pub amplitude: f32,
+    /// Poses recorded so far, when recording.
+    pub recording: Option<usize>,
+    /// Whether the scene has a stroke, and whether it is playing.
+    pub stroke: (bool, bool),
+}
+
+impl ScalpelInfo {
+    /// The state of `hand`.
+    pub fn of(hand: &super::hand_tool::HandTool) -> Self {
+        ScalpelInfo {
+            name: hand.tool.name().to_string(),
+            cutting: hand.input.cutting(),
+            depth: (hand.input.depth(), hand.input.geometry().max_depth),
+            force: hand.force,
+            amplitude: hand.amplitude,
+            recording: hand.recording(),
+            stroke: (hand.has_stroke(), hand.play_stroke),
+        }
+    }
 }
 
 /// What the panel shows about the running scene.
@@ -63,6 +107,8 @@ pub struct PanelInfo<'a> {
     pub device: String,
     /// Recent timings.
     pub times: &'a FrameTimes,
+    /// The scalpel.
+    pub scalpel: ScalpelInfo,
 }
 
 impl Panel {
@@ -77,6 +123,8 @@ impl Panel {
                     self.scene_section(ui, info, &mut actions);
                     ui.separator();
                     self.settings_section(ui, &mut actions);
+                    ui.separator();
+                    self.scalpel_section(ui, &info.scalpel, &mut actions);
                     ui.separator();
                     self.overlay_section(ui, info);
                     ui.separator();
@@ -93,13 +141,12 @@ impl Panel {
                             actions.push(Action::ResetView);
                         }
                     });
-                    ui.label("Stroke recording waits for the scalpel (issue 5).");
                     if !self.message.is_empty() {
                         ui.separator();
                         ui.label(&self.message);
                     }
                     ui.separator();
-                    ui.small("Drag: orbit · middle/shift-drag: pan · wheel: zoom · R: reset view · F: fullscreen · Space: play");
+                    ui.small("Left-drag: cut · right-drag: orbit · middle/shift+right-drag: pan · wheel: zoom (depth while cutting or with Ctrl) · R: reset view · F: fullscreen · Space: play");
                 });
             });
         (actions, shown.response.rect.width())
@@ -201,6 +248,51 @@ impl Panel {
         }
     }
 
+    fn scalpel_section(&mut self, ui: &mut egui::Ui, s: &ScalpelInfo, actions: &mut Vec<Action>) {
+        ui.heading("Scalpel");
+        ui.label(format!(
+            "{} · {}",
+            s.name,
+            if s.cutting { "cutting" } else { "lifted" }
+        ));
+        let (depth, max) = s.depth;
+        let mut mm = depth * 1e3;
+        let r = ui.add(egui::Slider::new(&mut mm, 0.0..=max * 1e3).text("depth (mm)"));
+        if r.changed() {
+            actions.push(Action::SetDepth(mm * 1e-3));
+        }
+        if s.stroke.0 {
+            let mut play = s.stroke.1;
+            if ui.checkbox(&mut play, "play the scene's stroke").changed() {
+                actions.push(Action::PlayStroke(play));
+            }
+        }
+        ui.label(format!("tool force {:.3} N", s.force));
+        ui.add(
+            egui::ProgressBar::new(s.amplitude.clamp(0.0, 1.0))
+                .text(format!("haptic {:.2}", s.amplitude)),
+        );
+        ui.horizontal(|ui| {
+            ui.label("stroke file");
+            ui.text_edit_singleline(&mut self.stroke_file);
+        });
+        match s.recording {
+            None => {
+                if ui.button("Record stroke").clicked() {
+                    actions.push(Action::StartRecording);
+                }
+            }
+            Some(n) => {
+                ui.horizontal(|ui| {
+                    if ui.button("Stop and save").clicked() {
+                        actions.push(Action::StopRecording(PathBuf::from(&self.stroke_file)));
+                    }
+                    ui.label(format!("recording: {n} poses"));
+                });
+            }
+        }
+    }
+
     fn overlay_section(&mut self, ui: &mut egui::Ui, info: &PanelInfo<'_>) {
         ui.heading("Overlays");
         let o = &mut self.overlays;
@@ -209,10 +301,7 @@ impl Panel {
             legend(ui, info.stress_max);
         }
         ui.checkbox(&mut o.wireframe, "tet wireframe");
-        ui.checkbox(
-            &mut o.tool_spheres,
-            "tool spheres (with the scalpel, issue 5)",
-        );
+        ui.checkbox(&mut o.tool_spheres, "tool contact spheres");
         ui.checkbox(&mut o.pinned, "pinned nodes");
     }
 }

@@ -13,9 +13,10 @@ use incise_sim::xpbd::FrameStats;
 use incise_sim::{Material, Solver};
 use incise_xr::RenderDevice;
 
+use super::hand_tool::HandTool;
 use crate::body::{Body, DeviceChoice};
-use crate::scene::{Scene, build_scene, load_scene};
-use crate::screenshots::place_on;
+use crate::scene::{Scene, ToolDriver, build_scene_driven, load_scene};
+use crate::screenshots::{default_camera, place_on};
 
 /// Settings the panel changes while the scene runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,6 +52,9 @@ pub struct Session {
     density: f32,
     /// The last solver failure, shown in the panel.
     pub error: Option<String>,
+    /// The scalpel (the scene's, else the built-in No. 10), driven by the mouse or the
+    /// scene's stroke.
+    pub hand: HandTool,
 }
 
 /// `.ron` scene files in `dir` (not `materials.ron`), sorted.
@@ -72,7 +76,10 @@ impl Session {
     /// Load `path` and put its body on `device` (the GPU one on `dev`).
     pub fn load(path: &Path, device: DeviceChoice, dev: &RenderDevice) -> Result<Session> {
         let scene = load_scene(path)?;
-        let built = build_scene(&scene, path, None)?;
+        let mut built = build_scene_driven(&scene, path, None, ToolDriver::Hand)?;
+        let yaw = default_camera(built.solver.mesh()).yaw;
+        let hand = HandTool::for_scene(&mut built, yaw)
+            .with_context(|| format!("{}: tool", path.display()))?;
         let p = built.solver.params().clone();
         let params = LiveParams {
             youngs_modulus: built.material.youngs_modulus,
@@ -92,7 +99,20 @@ impl Session {
             params,
             pinned,
             error: None,
+            hand,
         })
+    }
+
+    /// Start recording a stroke: the scene is loaded again as its file says (frame 0,
+    /// its own settings, so `incise run SCENE --stroke FILE` replays the same physics) and
+    /// the blade keeps its place and mouse state.
+    pub fn start_recording(&mut self, dev: &RenderDevice) -> Result<()> {
+        let mut fresh = Session::load(&self.path, self.device, dev)?;
+        fresh.hand.input = self.hand.input.clone();
+        fresh.hand.play_stroke = self.hand.play_stroke && fresh.hand.has_stroke();
+        fresh.hand.start_recording(&mut fresh.body)?;
+        *self = fresh;
+        Ok(())
     }
 
     /// The scene's name.
@@ -103,8 +123,16 @@ impl Session {
     /// Step one frame; a solver failure is kept in [`Session::error`] and returned.
     pub fn step(&mut self) -> Result<(FrameStats, f64), String> {
         let t0 = Instant::now();
+        if let Err(e) = self.hand.before_step(&mut self.body) {
+            let msg = format!("{e:#}");
+            self.error = Some(msg.clone());
+            return Err(msg);
+        }
         match self.body.step_frame() {
-            Ok(s) => Ok((s, t0.elapsed().as_secs_f64() * 1e3)),
+            Ok(s) => {
+                self.hand.after_step(&s);
+                Ok((s, t0.elapsed().as_secs_f64() * 1e3))
+            }
             Err(e) => {
                 let msg = e.to_string();
                 self.error = Some(msg.clone());
@@ -132,6 +160,11 @@ impl Session {
     ) -> Result<()> {
         let old = self.params;
         self.params = params;
+        // The new solver counts frames from 0: the scene's stroke would restart, so the
+        // mouse takes the blade where the stroke has it now.
+        let cur = self.body.solver();
+        self.hand
+            .take_mouse(cur.frame(), cur.params().frame_dt as f64);
         let solver = match self.fresh_solver(Some(self.body.solver())) {
             Ok(s) => s,
             Err(e) => {
@@ -170,6 +203,10 @@ impl Session {
             s.release(&released);
         }
         s.pin(&self.pinned);
+        let frame = from.map_or(0, |f| f.frame());
+        let (contact, pose) = self.hand.attachment(frame, cur.params().frame_dt as f64);
+        s.set_tool(contact, pose)
+            .with_context(|| format!("{}: tool", self.path.display()))?;
         for (i, g) in self.scene.grabs.iter().enumerate() {
             let nodes = g
                 .nodes

@@ -1,0 +1,125 @@
+//! The preview's mouse scalpel without a window (issue 6): a scripted sequence of
+//! synthetic mouse events (press on the tissue, drag, wheel, release) goes through the
+//! same cursor → ray → plane → pose logic and per-frame tool driving as the preview,
+//! records the stroke, and `incise run SCENE --stroke FILE` replays it releasing the very
+//! same tets.
+
+mod common;
+
+use common::{incise, temp_dir, text};
+use glam::{Vec2, Vec3};
+use incise::body::Body;
+use incise::preview::hand_tool::HandTool;
+use incise::preview::pick::pick_tissue;
+use incise::scene::{ToolDriver, build_scene_driven, load_scene};
+use incise::screenshots::default_camera;
+use serde_json::Value;
+
+/// Released tets of a body.
+fn released(body: &Body) -> Vec<u64> {
+    let cut = body.solver().cut();
+    (0..body.solver().mesh().tet_count())
+        .filter(|&t| !cut.is_live(t))
+        .map(|t| t as u64)
+        .collect()
+}
+
+#[test]
+fn a_mouse_stroke_cuts_records_and_replays_the_same_tets() {
+    let path = std::path::Path::new("config/plate_cut.ron");
+    let scene = load_scene(path).unwrap();
+    let mut built = build_scene_driven(&scene, path, None, ToolDriver::Hand).unwrap();
+    let camera = default_camera(built.solver.mesh());
+    let mut hand = HandTool::for_scene(&mut built, camera.yaw).unwrap();
+    let mut body = Body::Cpu(Box::new(built.solver));
+    let dt = body.solver().params().frame_dt as f64;
+    // The mouse takes the blade from the scene's scripted stroke, then records.
+    hand.take_mouse(0, dt);
+    hand.start_recording(&mut body).unwrap();
+
+    // The window: 1280 × 720 through the preview's default camera.
+    let size = Vec2::new(1280.0, 720.0);
+    let view = camera.view(size.x / size.y);
+    let pixel = |p: Vec3| view.project(p, size).unwrap();
+    let (a, b) = (Vec3::new(0.02, 0.02, 0.02), Vec3::new(0.05, 0.02, 0.02));
+    let step = |hand: &mut HandTool, body: &mut Body| {
+        hand.before_step(body).unwrap();
+        let stats = body.step_frame().unwrap();
+        hand.after_step(&stats);
+    };
+    // Cursor over a, left button down: the ray picks the slab's top there.
+    let (o, d) = view.ray(pixel(a), size);
+    hand.input.cursor(o, d);
+    let s = body.solver();
+    let hit = pick_tissue(o, d, s.mesh(), s.cut(), s.positions()).expect("tissue under a");
+    assert!((hit - a).length() < 1e-4, "picked {hit}");
+    assert!(hand.input.press(Some(hit)));
+    // One and a half notches toward the user: 0.75 mm deeper.
+    let d0 = hand.input.depth();
+    assert!((hand.input.wheel(-1.5) - (d0 + 0.00075)).abs() < 1e-6);
+    // Let the blade sink, then drag to b over 50 frames, then release and lift.
+    for _ in 0..30 {
+        step(&mut hand, &mut body);
+    }
+    let mut peak_force = 0.0f32;
+    for i in 1..=50 {
+        let p = a + (b - a) * (i as f32 / 50.0);
+        let (o, d) = view.ray(pixel(p), size);
+        hand.input.cursor(o, d);
+        step(&mut hand, &mut body);
+        peak_force = peak_force.max(hand.force);
+    }
+    hand.input.release();
+    for _ in 0..10 {
+        step(&mut hand, &mut body);
+    }
+    let frames = body.solver().frame();
+    assert_eq!(frames, 90);
+    assert!(
+        peak_force > 0.01,
+        "the tissue never pushed back ({peak_force} N)"
+    );
+    assert!(hand.amplitude >= 0.0 && hand.amplitude <= 1.0);
+    let cut = released(&body);
+    eprintln!(
+        "mouse stroke: {} tets released, peak tool force {peak_force:.3} N",
+        cut.len()
+    );
+    assert!(
+        cut.len() > 20,
+        "the mouse stroke released {} tets",
+        cut.len()
+    );
+
+    let dir = temp_dir("preview-scalpel");
+    let file = dir.join("mouse_stroke.ron");
+    let rec = hand.stop_recording(&file).unwrap();
+    assert_eq!((rec.poses, rec.frames), (91, 90));
+
+    let out = dir.join("replay");
+    let o = incise(&[
+        "run",
+        "config/plate_cut.ron",
+        "--device",
+        "cpu",
+        "--frames",
+        "90",
+        "--vtu-every",
+        "0",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--stroke",
+        file.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let replayed: Vec<u64> = report["released_tets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    assert_eq!(replayed, cut, "the replay released other tets");
+}
