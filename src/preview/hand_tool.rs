@@ -44,17 +44,20 @@ pub struct HandTool {
 }
 
 impl HandTool {
-    /// The scene's tool, hovering over the top centre of the tissue's rest bounds
-    /// `(lo, hi)`, its flat turned toward a camera at `yaw`. A scene's stroke is played
+    /// The scene's tool, parked high over the top centre of the tissue's rest bounds
+    /// `(lo, hi)` until the cursor brings it down, its flat turned toward a camera at
+    /// `yaw`. A scene's stroke is played
     /// until the mouse takes the blade.
     pub fn new(t: SceneTool, (lo, hi): (Vec3, Vec3), yaw: f32) -> HandTool {
         let top = Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z);
-        let input = ScalpelInput::new(
+        let mut input = ScalpelInput::new(
             BladeGeometry::of(&t.tool),
             ScalpelFeel::default(),
             top,
             yaw + std::f32::consts::FRAC_PI_2,
         );
+        // Parked one bounding-box diagonal up: clear of tissue that grabs lift.
+        input.park((hi - lo).length());
         HandTool {
             play_stroke: t.stroke.is_some(),
             tool: t.tool,

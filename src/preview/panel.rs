@@ -64,6 +64,8 @@ pub struct ScalpelInfo {
     pub name: String,
     /// Whether the left button holds the blade in the tissue.
     pub cutting: bool,
+    /// Whether the blade waits parked above the tissue.
+    pub parked: bool,
     /// Cut depth and its limit, m.
     pub depth: (f32, f32),
     /// Tissue force on the tool in the last frame, N.
@@ -82,6 +84,7 @@ impl ScalpelInfo {
         ScalpelInfo {
             name: hand.tool.name().to_string(),
             cutting: hand.input.cutting(),
+            parked: hand.input.is_parked(),
             depth: (hand.input.depth(), hand.input.geometry().max_depth),
             force: hand.force,
             amplitude: hand.amplitude,
@@ -250,11 +253,13 @@ impl Panel {
 
     fn scalpel_section(&mut self, ui: &mut egui::Ui, s: &ScalpelInfo, actions: &mut Vec<Action>) {
         ui.heading("Scalpel");
-        ui.label(format!(
-            "{} · {}",
-            s.name,
-            if s.cutting { "cutting" } else { "lifted" }
-        ));
+        let state = match (s.stroke.1, s.cutting, s.parked) {
+            (true, ..) => "the scene's stroke moves it",
+            (_, true, _) => "cutting",
+            (_, _, true) => "parked: move the cursor over the tissue",
+            _ => "lifted",
+        };
+        ui.label(format!("{} · {state}", s.name));
         let (depth, max) = s.depth;
         let mut mm = depth * 1e3;
         let r = ui.add(egui::Slider::new(&mut mm, 0.0..=max * 1e3).text("depth (mm)"));

@@ -84,6 +84,8 @@ pub struct ScalpelInput {
     heading: f32,
     cutting: bool,
     depth: f32,
+    /// Extra height while parked (before the mouse first moves the blade), m.
+    parked: f32,
     pose: ToolPose,
 }
 
@@ -116,10 +118,23 @@ impl ScalpelInput {
             heading,
             cutting: false,
             depth: (0.5 * geometry.max_depth).min(0.005),
+            parked: 0.0,
             pose: ToolPose::new(Vec3::ZERO, Quat::IDENTITY),
         };
         s.pose = s.target_pose();
         s
+    }
+
+    /// Park the blade `height` m above its hover height, out of the tissue's way, until
+    /// the cursor first moves it (so a scene nobody cuts runs as it does headless).
+    pub fn park(&mut self, height: f32) {
+        self.parked = height.max(0.0);
+        self.pose = self.target_pose();
+    }
+
+    /// Whether the blade waits parked for the cursor.
+    pub fn is_parked(&self) -> bool {
+        self.parked > 0.0
     }
 
     /// Take the blade over from wherever something else put it (the scene's stroke): it
@@ -137,6 +152,7 @@ impl ScalpelInput {
     pub fn cursor(&mut self, origin: Vec3, dir: Vec3) {
         if let Some(p) = ray_plane(origin, dir, self.plane_z) {
             self.target = p;
+            self.parked = 0.0;
         }
     }
 
@@ -148,6 +164,7 @@ impl ScalpelInput {
         self.plane_z = p.z;
         self.target = p.truncate();
         self.cutting = true;
+        self.parked = 0.0;
         true
     }
 
@@ -202,7 +219,7 @@ impl ScalpelInput {
         let edge_z = if self.cutting {
             self.plane_z - self.depth
         } else {
-            self.plane_z + self.feel.hover
+            self.plane_z + self.feel.hover + self.parked
         };
         ToolPose::new(
             self.target.extend(edge_z + self.geometry.drop),
@@ -336,6 +353,23 @@ mod tests {
         // A miss starts nothing.
         s.release();
         assert!(!s.press(None) && !s.cutting());
+    }
+
+    #[test]
+    fn a_parked_blade_waits_above_until_the_cursor_moves_it() {
+        let over = Vec3::new(0.0, 0.0, 0.02);
+        let mut s = ScalpelInput::new(BLADE, ScalpelFeel::default(), over, 0.0);
+        s.park(0.1);
+        let parked_z = 0.02 + 0.005 + 0.1 + 0.005;
+        assert!(s.is_parked());
+        assert!((s.pose().position.z - parked_z).abs() < 1e-6);
+        assert!((s.advance(0.01).position.z - parked_z).abs() < 1e-6);
+        // A ray that misses the plane leaves it parked; one that meets it brings it down.
+        s.cursor(Vec3::Z, Vec3::X);
+        assert!(s.is_parked());
+        s.cursor(Vec3::new(0.0, 0.0, 1.0), -Vec3::Z);
+        assert!(!s.is_parked());
+        assert!(s.advance(0.01).position.z < parked_z - 1e-4);
     }
 
     #[test]
