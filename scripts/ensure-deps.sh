@@ -22,6 +22,8 @@ ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' || missing+=(libvulkan1)
 # libraries winit loads at run time.
 command -v xvfb-run >/dev/null 2>&1 || missing+=(xvfb)
 command -v xauth >/dev/null 2>&1 || missing+=(xauth)
+# xdotool drives the mouse in the preview's scalpel-drag test.
+command -v xdotool >/dev/null 2>&1 || missing+=(xdotool)
 ldconfig -p 2>/dev/null | grep -q 'libxkbcommon-x11.so.0' || missing+=(libxkbcommon-x11-0)
 ldconfig -p 2>/dev/null | grep -q 'libXcursor.so.1' || missing+=(libxcursor1)
 ldconfig -p 2>/dev/null | grep -q 'libXi.so.6' || missing+=(libxi6)

@@ -3,8 +3,11 @@
 //! `--frames`; without a display it refuses with a clear message, and `incise` with no
 //! arguments falls back to the headless run.
 //!
-//! Needs `xvfb-run` (scripts/ensure-deps.sh installs it) and a wgpu adapter; without
-//! them the window test prints why and passes, unless `INCISE_REQUIRE_GPU=1` (CI).
+//! A left-drag in the window (xdotool) cuts the tissue with the mouse scalpel.
+//!
+//! Needs `xvfb-run` and `xdotool` (scripts/ensure-deps.sh installs them) and a wgpu
+//! adapter; without them the window tests print why and pass, unless
+//! `INCISE_REQUIRE_GPU=1` (CI).
 
 mod common;
 
@@ -79,6 +82,87 @@ fn preview_opens_a_window_renders_and_exits_after_n_frames() {
         reddish > 300,
         "the beam's tissue should be on screen ({reddish} pixels)"
     );
+}
+
+/// The scalpel scene without its own tool and stroke: only the mouse can cut it.
+fn untooled_plate(dir: &std::path::Path) -> std::path::PathBuf {
+    std::fs::copy("config/materials.ron", dir.join("materials.ron")).unwrap();
+    let s = std::fs::read_to_string("config/plate_cut.ron").unwrap();
+    let plain = format!(
+        "{}{}",
+        &s[..s.find("    tool: Some(").unwrap()],
+        &s[s.find("    duration:").unwrap()..]
+    );
+    let path = dir.join("plate.ron");
+    std::fs::write(&path, plain).unwrap();
+    path
+}
+
+#[test]
+fn a_left_drag_in_the_window_cuts_the_tissue() {
+    let have = |tool: &str| {
+        Command::new("which")
+            .arg(tool)
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !have("xvfb-run") || !have("xdotool") {
+        assert!(
+            !required(),
+            "INCISE_REQUIRE_GPU=1 but xvfb-run or xdotool is missing"
+        );
+        eprintln!("skipping: xvfb-run or xdotool is not installed");
+        return;
+    }
+    let dir = temp_dir("xvfb-drag");
+    let scene = untooled_plate(&dir);
+    let shot = dir.join("drag.png");
+    // In the 900 × 600 window the slab's top is around (500, 235) (preview camera, panel
+    // on the left). Press there, let the blade sink, drag 15 cm of screen to the lower
+    // right, release, then Escape: the last frame is saved and the window closes.
+    let script = format!(
+        r#"timeout 120 {bin} preview {scene} --frames 100000 --size 900x600 --device cpu --screenshot {shot} &
+P=$!
+W=$(xdotool search --sync --name "incise preview")
+sleep 2
+xdotool mousemove --window $W 500 235
+sleep 0.5
+xdotool mousedown 1
+sleep 6
+for i in $(seq 0 30); do xdotool mousemove --window $W $((500+i*5)) $((235+i)); sleep 0.2; done
+sleep 1
+xdotool mouseup 1
+sleep 1
+xdotool windowfocus $W
+sleep 0.5
+xdotool key Escape
+wait $P"#,
+        bin = env!("CARGO_BIN_EXE_incise"),
+        scene = scene.display(),
+        shot = shot.display(),
+    );
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", "bash", "-c", &script])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", &dir)
+        .output()
+        .expect("xvfb-run runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    if !o.status.success() && err.contains("no GPU adapter") && !required() {
+        eprintln!("skipping: {err}");
+        return;
+    }
+    assert!(o.status.success(), "preview failed: {err}");
+    let img = RgbaImage::load_png(&shot).unwrap();
+    // The cut surface's wet red (the skin is pink: much more green), in the 3D view.
+    let cut = (0..img.height)
+        .flat_map(|y| (300..img.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.get(x, y);
+            p[0] > 150 && p[1] < 110 && p[2] < 130
+        })
+        .count();
+    assert!(cut > 200, "no cut surface after the drag ({cut} pixels)");
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! `incise preview`: the desktop window (winit) with the incise-xr renderer, an egui
 //! side panel, orbit/pan/zoom and the mouse scalpel (left-drag cuts, see
 //! [`scalpel_input`]). `--frames N` renders N frames and exits (for tests and scripts);
-//! `--screenshot FILE` saves the window's last frame.
+//! `--screenshot FILE` saves the window's last frame (also when Escape closes it).
 
 mod camera_input;
 pub mod display;
@@ -101,6 +101,8 @@ struct Live {
     left_down: bool,
     /// Ctrl is held (the wheel sets the depth).
     ctrl: bool,
+    /// Escape was pressed: the next frame is the last.
+    quitting: bool,
 }
 
 impl ApplicationHandler for App {
@@ -170,7 +172,8 @@ impl ApplicationHandler for App {
                 {
                     KeyAction::None => {}
                     KeyAction::PlayPause => live.panel.playing = !live.panel.playing,
-                    KeyAction::Quit => event_loop.exit(),
+                    // Finish with one more frame (saving `--screenshot`), then close.
+                    KeyAction::Quit => live.quitting = true,
                     KeyAction::Fullscreen => {
                         let full = live
                             .window
@@ -262,6 +265,7 @@ impl Live {
             cursor: None,
             left_down: false,
             ctrl: false,
+            quitting: false,
         })
     }
 
@@ -347,7 +351,7 @@ impl Live {
         for a in actions {
             self.act(a)?;
         }
-        let last = opts.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
+        let last = self.quitting || opts.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let capture = self.capture_next || (last && opts.screenshot.is_some());
         let solver = self.session.body.solver();
         let mut state = BodyState::of_solver(solver, &self.session.pinned);

@@ -240,9 +240,17 @@ impl ScalpelInput {
             let max = self.feel.turn_rate * dt;
             self.heading = angle_diff(self.heading + turn.clamp(-max, max), 0.0);
         }
-        let dz = (goal.z - at.z).clamp(-self.feel.sink_speed * dt, self.feel.sink_speed * dt);
+        // Above the hover height (parked) the blade comes down at the horizontal speed,
+        // no lower than that height; near and in the tissue at the sink speed.
+        let hover_tip = self.plane_z + self.feel.hover + self.geometry.drop;
+        let z = if goal.z < at.z && at.z > hover_tip {
+            (at.z - self.feel.speed * dt).max(goal.z.max(hover_tip))
+        } else {
+            let slow = self.feel.sink_speed * dt;
+            at.z + (goal.z - at.z).clamp(-slow, slow)
+        };
         self.pose = ToolPose::new(
-            (at.truncate() + step).extend(at.z + dz),
+            (at.truncate() + step).extend(z),
             Quat::from_rotation_z(self.heading),
         );
         self.pose
@@ -369,7 +377,13 @@ mod tests {
         assert!(s.is_parked());
         s.cursor(Vec3::new(0.0, 0.0, 1.0), -Vec3::Z);
         assert!(!s.is_parked());
-        assert!(s.advance(0.01).position.z < parked_z - 1e-4);
+        // Down at 0.1 m/s (1 mm in 10 ms) while above the hover height, and no lower.
+        let z = s.advance(0.01).position.z;
+        assert!((z - (parked_z - 0.001)).abs() < 1e-6, "{z}");
+        for _ in 0..200 {
+            s.advance(0.01);
+        }
+        assert!((s.pose().position.z - (0.02 + 0.005 + 0.005)).abs() < 1e-6);
     }
 
     #[test]
