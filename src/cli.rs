@@ -59,6 +59,14 @@ pub enum Command {
         /// Record the scalpel's pose every frame to this stroke file.
         #[arg(long)]
         record_stroke: Option<PathBuf>,
+        /// Testing aid: destroy the GPU device just before frame N (the run must go on
+        /// on the CPU with a warning in report.json).
+        #[arg(long, value_name = "N")]
+        inject_gpu_loss_at: Option<u64>,
+        /// Testing aid: give a node a NaN velocity just before frame N (the run must stop
+        /// with the frame and tet named, the frame rolled back, the output kept).
+        #[arg(long, value_name = "N")]
+        inject_nan_at: Option<u64>,
     },
     /// Open the desktop preview: the scene in a window with a control panel.
     Preview {

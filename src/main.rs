@@ -40,6 +40,8 @@ fn default_command() -> Command {
                 haptic_rate: None,
                 stroke: None,
                 record_stroke: None,
+                inject_gpu_loss_at: None,
+                inject_nan_at: None,
             }
         }
     }
@@ -62,6 +64,8 @@ fn main() -> ExitCode {
             haptic_rate,
             stroke,
             record_stroke,
+            inject_gpu_loss_at,
+            inject_nan_at,
         } => run_scene(&RunOptions {
             scene,
             frames,
@@ -75,6 +79,8 @@ fn main() -> ExitCode {
             haptic_rate,
             stroke,
             record_stroke,
+            inject_gpu_loss_at,
+            inject_nan_at,
         })
         .map(|o| {
             println!("{}", o.report.summary());

@@ -326,6 +326,14 @@ impl Solver {
         &self.near_edge
     }
 
+    /// Fault injection for tests: give free node `node` a NaN velocity, as a solver bug
+    /// would; the next frame must stop with `SolverError::NonFinite` and roll back.
+    pub fn inject_non_finite(&mut self, node: usize) {
+        if let Some(v) = self.v.get_mut(node) {
+            *v = Vec3::NAN;
+        }
+    }
+
     /// Release tets by hand (mesh indices); returns what changed.
     pub fn release(&mut self, tets: &[u32]) -> ReleaseEvent {
         let ev = self.cut.release(&self.mesh, tets);
