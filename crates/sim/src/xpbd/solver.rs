@@ -169,6 +169,12 @@ impl Solver {
             params,
             mesh,
         };
+        // Nodes in no tet have no mass: they are not simulated (PHYSICS.md §1.1 masses).
+        for (k, m) in solver.kind.iter_mut().zip(&solver.mass) {
+            if *m <= 0.0 {
+                *k = NodeKind::Retired;
+            }
+        }
         solver.slots = order
             .iter()
             .map(|&t| TetSlot {
