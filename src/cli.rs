@@ -146,6 +146,21 @@ pub enum Command {
         #[arg(long)]
         scaling: bool,
     },
+    /// Endurance run: cut a scalpel scene, reset, cut again for a wall-clock duration;
+    /// fails (exit 1) if memory grows > 5 %, file descriptors leak or a cut differs.
+    Soak {
+        /// Scene file with a tool and a stroke, e.g. config/plate_cut.ron.
+        scene: PathBuf,
+        /// Wall-clock duration in seconds (at least three cuts are made).
+        #[arg(long, default_value_t = 3600.0)]
+        seconds: f64,
+        /// Where the solver runs.
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+        /// Output folder for soak.json.
+        #[arg(long, default_value = "out/soak")]
+        out: PathBuf,
+    },
     /// Reproducible experiments that write the CSV tables and PNG figures of docs/experiments/.
     Experiment {
         /// Which experiment.

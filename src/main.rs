@@ -132,6 +132,36 @@ fn main() -> ExitCode {
             device,
             scaling,
         } => bench::run(case, frames, json, device, scaling),
+        Command::Soak {
+            scene,
+            seconds,
+            device,
+            out,
+        } => incise::soak::run(&incise::soak::SoakOptions {
+            scene,
+            seconds,
+            device,
+            out: out.clone(),
+        })
+        .and_then(|r| {
+            let last = r.cycles.last();
+            println!(
+                "{} cuts in {:.0} s on {}: memory {:+.1} %, descriptors {:+}, p99 frame {:.1} ms (last cut), every cut {} the first",
+                r.cycles.len(),
+                r.seconds,
+                r.device,
+                r.rss_growth * 100.0,
+                r.fd_growth,
+                last.map_or(0.0, |c| c.p99_ms),
+                if r.problems.iter().any(|p| p.contains("other tets")) { "differs from" } else { "matches" },
+            );
+            println!("report: {}", out.join("soak.json").display());
+            if r.passed {
+                Ok(())
+            } else {
+                Err(anyhow::anyhow!("soak failed: {}", r.problems.join("; ")))
+            }
+        }),
         Command::Experiment { command } => match command {
             ExperimentCommand::Rheology { out, presets } => {
                 experiment::rheology::run(&experiment::rheology::RheologyOptions { out, presets })
