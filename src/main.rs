@@ -7,7 +7,7 @@ use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
 use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
 use incise::screenshots::ImageSize;
-use incise::{bench, bench_render, compare, experiment, mesh_cmd, screenshots};
+use incise::{bench, bench_render, compare, exercise, experiment, mesh_cmd, screenshots};
 
 /// The scene opened when none is named.
 const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
@@ -126,6 +126,29 @@ fn main() -> ExitCode {
             device,
             scaling,
         } => bench::run(case, frames, json, device, scaling),
+        Command::Exercise {
+            exercise,
+            stroke,
+            out,
+            device,
+            history,
+            quiet,
+        } => exercise::run_exercise(&exercise::ExerciseOptions {
+            exercise,
+            stroke,
+            out,
+            device,
+            history: history.clone(),
+            quiet,
+        })
+        .map(|a| {
+            println!("{}", a.result.summary());
+            println!("result: {}", a.result_path.display());
+            println!("report: {}", a.html_path.display());
+            println!("history: {}", history.display());
+        }),
+        Command::Results { history } => exercise::read_history(&history)
+            .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {
             ExperimentCommand::Rheology { out, presets } => {
                 experiment::rheology::run(&experiment::rheology::RheologyOptions { out, presets })
