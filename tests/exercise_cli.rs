@@ -50,46 +50,76 @@ fn blade_geometry(depth: f32) -> (f32, f32, f32) {
     (-low, a, b)
 }
 
-/// A stroke whose edge cuts the straight plan at `depth`, shifted by `offset` and with a
-/// sideways wobble of `wobble` m amplitude (1 cm wavelength) while cutting.
-fn stroke(depth: f32, offset: Vec3, wobble: f32) -> Stroke {
+/// Point at arc length `s` along the polyline `path`, extended straight past its ends.
+fn point_at(path: &[Vec3], s: f32) -> Vec3 {
+    let mut s0 = 0.0;
+    for (k, w) in path.windows(2).enumerate() {
+        let len = (w[1] - w[0]).length();
+        if s <= s0 + len || k == path.len() - 2 {
+            return w[0] + (w[1] - w[0]) * ((s - s0) / len);
+        }
+        s0 += len;
+    }
+    path[0]
+}
+
+/// A stroke whose cutting edge follows the polyline `path` (on the surface) at `depth`:
+/// the tip runs along it with the blade aimed at the point of the path where the edge
+/// leaves the tissue, so the part of the edge below the surface lies along the path. The
+/// whole stroke is moved by `offset`, and swings sideways by `wobble` m (1 cm wavelength)
+/// while cutting.
+fn stroke_along(path: &[Vec3], depth: f32, offset: Vec3, wobble: f32) -> Stroke {
     let (lift, a, b) = blade_geometry(depth);
-    let dir = (PLAN[1] - PLAN[0]).normalize();
-    let up = Vec3::Z * (lift - depth);
-    let start = PLAN[0] - dir * a + up + offset;
-    let end = PLAN[1] - dir * b + up + offset;
-    let rotation = rotation();
+    let length: f32 = path.windows(2).map(|w| (w[1] - w[0]).length()).sum();
+    let down = Vec3::Z * (lift - depth) + offset;
+    let pose = |s: f32, side: f32| {
+        let tip = point_at(path, s);
+        let heading = ((point_at(path, s + b - a) - tip) * Vec3::new(1.0, 1.0, 0.0)).normalize();
+        let position = tip + down + Vec3::Z.cross(heading) * side;
+        (
+            position,
+            Quat::from_rotation_z(heading.y.atan2(heading.x)) * rotation(),
+        )
+    };
+    let (s0, s1) = (-a, length - b);
+    let (first, rotation) = pose(s0, 0.0);
     let mut keys = vec![PoseKey {
         t: 0.0,
-        position: start + Vec3::Z * (depth + APPROACH),
+        position: first + Vec3::Z * (depth + APPROACH),
         rotation,
     }];
     let mut t = (depth + APPROACH) as f64 / SPEED as f64;
     keys.push(PoseKey {
         t,
-        position: start,
+        position: first,
         rotation,
     });
-    let len = (end - start).length();
-    let n = (len / 0.001).ceil() as usize;
+    let n = ((s1 - s0) / 0.001).ceil() as usize;
+    let mut last = first;
     for k in 1..=n {
-        let u = k as f32 / n as f32;
-        let along = u * len;
+        let along = (s1 - s0) * k as f32 / n as f32;
         let side = wobble * (std::f32::consts::TAU * along / 0.01).sin();
-        t += (len / n as f32 / SPEED) as f64;
+        let (position, rotation) = pose(s0 + along, side);
+        t += ((s1 - s0) / n as f32 / SPEED) as f64;
         keys.push(PoseKey {
             t,
-            position: start.lerp(end, u) + Vec3::Y * side,
+            position,
             rotation,
         });
+        last = position;
     }
     t += (depth + APPROACH) as f64 / SPEED as f64;
     keys.push(PoseKey {
         t,
-        position: end + Vec3::Z * (depth + APPROACH),
-        rotation,
+        position: last + Vec3::Z * (depth + APPROACH),
+        rotation: keys[keys.len() - 1].rotation,
     });
     Stroke::new(keys).unwrap()
+}
+
+/// A stroke along the straight plan of slab_depth.ron.
+fn stroke(depth: f32, offset: Vec3, wobble: f32) -> Stroke {
+    stroke_along(&PLAN, depth, offset, wobble)
 }
 
 /// Score `stroke` on `exercise`; the parsed result.json.
@@ -204,6 +234,40 @@ fn collateral_damage_grows_with_lateral_wobble() {
     assert!(
         damage[0] < damage[1] && damage[1] < damage[2],
         "collateral volume for wobble 0, 3, 6 mm: {damage:?} m³"
+    );
+}
+
+#[test]
+fn curved_stroke_follows_the_arc_and_a_straight_one_fails_it() {
+    let dir = temp_dir("exercise-arc");
+    let exercise = "config/exercises/slab_arc.ron";
+    let ex = incise::exercise::load_exercise(Path::new(exercise)).unwrap();
+    let arc: Vec<Vec3> = ex.plan.points.iter().map(|p| p.as_vec3()).collect();
+    let follow = attempt(
+        &dir,
+        "follow",
+        exercise,
+        &stroke_along(&arc, 0.003, Vec3::ZERO, 0.0),
+    );
+    assert_eq!(follow["verdict"]["passed"], true, "{}", follow["verdict"]);
+    let chord = [arc[0], arc[arc.len() - 1]];
+    let straight = attempt(
+        &dir,
+        "chord",
+        exercise,
+        &stroke_along(&chord, 0.003, Vec3::ZERO, 0.0),
+    );
+    assert_eq!(straight["verdict"]["passed"], false);
+    assert!(
+        failed(&straight).contains(&"completion".to_string()),
+        "{:?}",
+        failed(&straight)
+    );
+    assert!(
+        metric(&straight, "mean_deviation") > 2.0 * metric(&follow, "mean_deviation"),
+        "straight {} vs along the arc {}",
+        straight["metrics"],
+        follow["metrics"]
     );
 }
 
