@@ -146,8 +146,15 @@ pub enum Command {
         exercise: PathBuf,
         /// Stroke file (RON timed poses: recorded with `incise run --record-stroke`, or
         /// scripted).
-        #[arg(long)]
-        stroke: PathBuf,
+        #[arg(long, required_unless_present = "reference_stroke")]
+        stroke: Option<PathBuf>,
+        /// Instead of scoring, write the exercise's reference stroke (the scene's scalpel
+        /// along the plan at the target depth, handle raised `--tilt`) to this file.
+        #[arg(long, conflicts_with = "stroke")]
+        reference_stroke: Option<PathBuf>,
+        /// Reference stroke: angle of the blade's spine above the surface, degrees.
+        #[arg(long, default_value_t = 30.0)]
+        tilt: f32,
         /// Output folder.
         #[arg(long, default_value = "out/exercise")]
         out: PathBuf,

@@ -128,11 +128,20 @@ fn main() -> ExitCode {
         } => bench::run(case, frames, json, device, scaling),
         Command::Exercise {
             exercise,
-            stroke,
+            reference_stroke: Some(file),
+            tilt,
+            ..
+        } => exercise::write_reference_stroke(&exercise, &file, tilt).map(|()| {
+            println!("wrote {}", file.display());
+        }),
+        Command::Exercise {
+            exercise,
+            stroke: Some(stroke),
             out,
             device,
             history,
             quiet,
+            ..
         } => exercise::run_exercise(&exercise::ExerciseOptions {
             exercise,
             stroke,
@@ -147,6 +156,9 @@ fn main() -> ExitCode {
             println!("report: {}", a.html_path.display());
             println!("history: {}", history.display());
         }),
+        Command::Exercise { .. } => Err(anyhow::anyhow!(
+            "incise exercise needs --stroke FILE (or --reference-stroke FILE)"
+        )),
         Command::Results { history } => exercise::read_history(&history)
             .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {

@@ -238,18 +238,34 @@ fn collateral_damage_grows_with_lateral_wobble() {
 }
 
 #[test]
-fn curved_stroke_follows_the_arc_and_a_straight_one_fails_it() {
+fn reference_stroke_follows_the_arc_and_a_straight_one_fails_it() {
     let dir = temp_dir("exercise-arc");
     let exercise = "config/exercises/slab_arc.ron";
-    let ex = incise::exercise::load_exercise(Path::new(exercise)).unwrap();
-    let arc: Vec<Vec3> = ex.plan.points.iter().map(|p| p.as_vec3()).collect();
+    // The exercise's reference stroke, from the command line: the blade turned along the
+    // arc.
+    let reference = dir.join("reference.ron");
+    let o = incise(&[
+        "exercise",
+        exercise,
+        "--reference-stroke",
+        reference.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
     let follow = attempt(
         &dir,
         "follow",
         exercise,
-        &stroke_along(&arc, 0.003, Vec3::ZERO, 0.0),
+        &incise_scalpel::load_stroke(&reference).unwrap(),
     );
     assert_eq!(follow["verdict"]["passed"], true, "{}", follow["verdict"]);
+    assert!(
+        metric(&follow, "completion") >= 0.95,
+        "{}",
+        follow["metrics"]
+    );
+    // A straight stroke between the arc's ends misses most of it.
+    let ex = incise::exercise::load_exercise(Path::new(exercise)).unwrap();
+    let arc: Vec<Vec3> = ex.plan.points.iter().map(|p| p.as_vec3()).collect();
     let chord = [arc[0], arc[arc.len() - 1]];
     let straight = attempt(
         &dir,

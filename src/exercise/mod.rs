@@ -9,6 +9,7 @@ mod load;
 mod metrics;
 mod model;
 mod plan;
+mod reference;
 mod report_html;
 mod score;
 
@@ -20,4 +21,5 @@ pub use load::{LoadedExercise, load_exercise, parse_exercise};
 pub use metrics::{Metrics, STROKE_GAP_FRAMES, compute as compute_metrics};
 pub use model::{Exercise, PassThresholds, Tolerance};
 pub use plan::{Plan, PlanCoords, PlanSample, RestSurface};
+pub use reference::{ReferenceStyle, reference_stroke, write_reference_stroke};
 pub use score::{Check, Verdict, WEIGHTS, Weights, judge};
