@@ -161,6 +161,42 @@ pub enum Command {
         #[arg(long, default_value = "out/soak")]
         out: PathBuf,
     },
+    /// Score a stroke on a training exercise: runs the exercise's scene with the stroke
+    /// driving the scalpel, writes DIR/result.json and DIR/report.html and appends the
+    /// attempt to the results history.
+    Exercise {
+        /// Exercise file (RON), e.g. config/exercises/slab_depth.ron.
+        exercise: PathBuf,
+        /// Stroke file (RON timed poses: recorded with `incise run --record-stroke`, or
+        /// scripted).
+        #[arg(long, required_unless_present = "reference_stroke")]
+        stroke: Option<PathBuf>,
+        /// Instead of scoring, write the exercise's reference stroke (the scene's scalpel
+        /// along the plan at the target depth, handle raised `--tilt`) to this file.
+        #[arg(long, conflicts_with = "stroke")]
+        reference_stroke: Option<PathBuf>,
+        /// Reference stroke: angle of the blade's spine above the surface, degrees.
+        #[arg(long, default_value_t = 30.0)]
+        tilt: f32,
+        /// Output folder.
+        #[arg(long, default_value = "out/exercise")]
+        out: PathBuf,
+        /// Where the solver runs (auto: the GPU when an adapter exists, else the CPU).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+        /// Results history the attempt is appended to (one JSON line per attempt).
+        #[arg(long, default_value = "results/history.jsonl")]
+        history: PathBuf,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Print the results history as a table, oldest attempt first.
+    Results {
+        /// Results history file.
+        #[arg(long, default_value = "results/history.jsonl")]
+        history: PathBuf,
+    },
     /// Reproducible experiments that write the CSV tables and PNG figures of docs/experiments/.
     Experiment {
         /// Which experiment.

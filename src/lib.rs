@@ -6,6 +6,7 @@ pub mod bench_render;
 pub mod body;
 pub mod cli;
 pub mod compare;
+pub mod exercise;
 pub mod experiment;
 pub mod mesh_cmd;
 pub mod plot;

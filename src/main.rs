@@ -7,7 +7,7 @@ use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
 use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
 use incise::screenshots::ImageSize;
-use incise::{bench, bench_render, compare, experiment, mesh_cmd, screenshots};
+use incise::{bench, bench_render, compare, exercise, experiment, mesh_cmd, screenshots};
 
 /// The scene opened when none is named.
 const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
@@ -162,6 +162,41 @@ fn main() -> ExitCode {
                 Err(anyhow::anyhow!("soak failed: {}", r.problems.join("; ")))
             }
         }),
+        Command::Exercise {
+            exercise,
+            reference_stroke: Some(file),
+            tilt,
+            ..
+        } => exercise::write_reference_stroke(&exercise, &file, tilt).map(|()| {
+            println!("wrote {}", file.display());
+        }),
+        Command::Exercise {
+            exercise,
+            stroke: Some(stroke),
+            out,
+            device,
+            history,
+            quiet,
+            ..
+        } => exercise::run_exercise(&exercise::ExerciseOptions {
+            exercise,
+            stroke,
+            out,
+            device,
+            history: history.clone(),
+            quiet,
+        })
+        .map(|a| {
+            println!("{}", a.result.summary());
+            println!("result: {}", a.result_path.display());
+            println!("report: {}", a.html_path.display());
+            println!("history: {}", history.display());
+        }),
+        Command::Exercise { .. } => Err(anyhow::anyhow!(
+            "incise exercise needs --stroke FILE (or --reference-stroke FILE)"
+        )),
+        Command::Results { history } => exercise::read_history(&history)
+            .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {
             ExperimentCommand::Rheology { out, presets } => {
                 experiment::rheology::run(&experiment::rheology::RheologyOptions { out, presets })
