@@ -22,8 +22,15 @@ static METER: Meter = Meter;
 /// Slack for fixed-size allocations (error strings, path copies, hash tables' minimum).
 const SLACK: usize = 64 * 1024;
 
-/// Seed files written by our own writers from a 2 × 2 × 2-cell block, plus Gmsh samples.
+/// Seed files written by our own writers from a 2 × 2 × 2-cell block, plus Gmsh samples
+/// (made once per process: the tests run in parallel and would race on the files).
 fn seeds() -> Vec<(&'static str, Vec<Vec<u8>>)> {
+    static SEEDS: std::sync::OnceLock<Vec<(&'static str, Vec<Vec<u8>>)>> =
+        std::sync::OnceLock::new();
+    SEEDS.get_or_init(make_seeds).clone()
+}
+
+fn make_seeds() -> Vec<(&'static str, Vec<Vec<u8>>)> {
     let dir = std::env::temp_dir().join(format!("incise-fuzz-seeds-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mesh = common::block_mesh(Vec3::ZERO, Vec3::splat(0.01), UVec3::new(2, 2, 2));
