@@ -1,0 +1,136 @@
+//! The eye swapchain: one `array_size 2` OpenXR swapchain (layer 0 left, layer 1 right),
+//! each of its Vulkan images wrapped as a wgpu texture so the renderer draws into it.
+
+use ::openxr as xr;
+use ash::vk::{self, Handle};
+use wgpu::hal::{self, vulkan as hal_vk};
+
+use super::error::{XrError, xr_call};
+use crate::device::RenderDevice;
+
+/// The eye colour format: 8-bit sRGB, as the renderer's offscreen targets.
+pub const EYE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+/// The swapchain and its images as wgpu textures.
+pub struct EyeSwapchain {
+    /// The OpenXR swapchain.
+    pub handle: xr::Swapchain<xr::Vulkan>,
+    /// Its images, wrapped (index = the acquired image index).
+    pub textures: Vec<wgpu::Texture>,
+    /// Eye size, pixels.
+    pub size: (u32, u32),
+}
+
+impl EyeSwapchain {
+    /// A swapchain at the runtime's recommended eye size.
+    pub fn new(
+        instance: &xr::Instance,
+        system: xr::SystemId,
+        session: &xr::Session<xr::Vulkan>,
+        dev: &RenderDevice,
+    ) -> Result<Self, XrError> {
+        let views = instance
+            .enumerate_view_configuration_views(system, xr::ViewConfigurationType::PRIMARY_STEREO)
+            .map_err(xr_call("xrEnumerateViewConfigurationViews"))?;
+        let first = views
+            .first()
+            .ok_or_else(|| XrError::Gpu("the runtime reports no stereo views".into()))?;
+        let size = (
+            first.recommended_image_rect_width,
+            first.recommended_image_rect_height,
+        );
+        let vk_format = vk::Format::R8G8B8A8_SRGB;
+        let formats = session
+            .enumerate_swapchain_formats()
+            .map_err(xr_call("xrEnumerateSwapchainFormats"))?;
+        if !formats.contains(&(vk_format.as_raw() as u32)) {
+            return Err(XrError::Gpu(
+                "the runtime offers no R8G8B8A8_SRGB swapchain".into(),
+            ));
+        }
+        let handle = session
+            .create_swapchain(&xr::SwapchainCreateInfo {
+                create_flags: xr::SwapchainCreateFlags::EMPTY,
+                usage_flags: xr::SwapchainUsageFlags::COLOR_ATTACHMENT
+                    | xr::SwapchainUsageFlags::SAMPLED,
+                format: vk_format.as_raw() as u32,
+                sample_count: 1,
+                width: size.0,
+                height: size.1,
+                face_count: 1,
+                array_size: 2,
+                mip_count: 1,
+            })
+            .map_err(xr_call("xrCreateSwapchain"))?;
+        let images = handle
+            .enumerate_images()
+            .map_err(xr_call("xrEnumerateSwapchainImages"))?;
+        let desc = wgpu::TextureDescriptor {
+            label: Some("xr eye swapchain"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 2,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: EYE_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        };
+        let hal_desc = hal::TextureDescriptor {
+            label: Some("xr eye swapchain"),
+            size: desc.size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: EYE_FORMAT,
+            usage: wgpu::TextureUses::COLOR_TARGET | wgpu::TextureUses::RESOURCE,
+            memory_flags: hal::MemoryFlags::empty(),
+            view_formats: vec![],
+        };
+        let mut textures = Vec::with_capacity(images.len());
+        for image in images {
+            // SAFETY: the image belongs to the runtime's swapchain on this device, created
+            // with the format, size, layers and usage of `hal_desc`; the runtime owns it
+            // (a drop callback that does nothing, external memory) and the swapchain
+            // outlives the textures (dropped first in `XrSession`).
+            let texture = unsafe {
+                let hal_device = dev
+                    .device
+                    .as_hal::<hal::api::Vulkan>()
+                    .ok_or_else(|| XrError::Gpu("the render device is not Vulkan".into()))?;
+                let raw = hal_device.texture_from_raw(
+                    vk::Image::from_raw(image),
+                    &hal_desc,
+                    Some(Box::new(|| {})),
+                    hal_vk::TextureMemory::External,
+                );
+                dev.device.create_texture_from_hal::<hal::api::Vulkan>(
+                    raw,
+                    &desc,
+                    wgpu::TextureUses::UNINITIALIZED,
+                )
+            };
+            textures.push(texture);
+        }
+        Ok(EyeSwapchain {
+            handle,
+            textures,
+            size,
+        })
+    }
+
+    /// One view per eye (array layer) of image `index`.
+    pub fn eye_views(&self, index: usize) -> [wgpu::TextureView; 2] {
+        [0, 1].map(|layer| {
+            self.textures[index].create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        })
+    }
+}
