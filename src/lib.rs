@@ -17,3 +17,4 @@ pub mod run_mass_spring;
 pub mod run_rheology;
 pub mod scene;
 pub mod screenshots;
+pub mod xr;

@@ -41,6 +41,18 @@ pub fn scalpel_pose(grip: XrPose, offset: BladeOffset, tray: &Tray) -> ToolPose 
     }
 }
 
+/// The right grip pose that puts the scalpel at `tool` (sim world): the inverse of
+/// [`scalpel_pose`], for scripted controllers.
+pub fn grip_for_scalpel(tool: ToolPose, offset: BladeOffset, tray: &Tray) -> XrPose {
+    let tip_stage = tray.stage_from_sim().transform_point3(tool.position);
+    let rot_stage = tray.stage_from_sim_rotation() * tool.rotation;
+    let orientation = (rot_stage * offset.rotation.inverse()).normalize();
+    XrPose {
+        position: tip_stage - orientation * offset.tip,
+        orientation,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::f32::consts::FRAC_PI_2;

@@ -19,9 +19,9 @@ use crate::device::RenderDevice;
 const VIEW_TYPE: xr::ViewConfigurationType = xr::ViewConfigurationType::PRIMARY_STEREO;
 
 /// A running OpenXR session. Fields drop in order: swapchain textures before the
-/// swapchain, the session before the device, the instance last.
+/// swapchains, the session before the device, the instance last.
 pub struct XrSession {
-    swapchain: Option<EyeSwapchain>,
+    swapchains: Option<[EyeSwapchain; 2]>,
     actions: XrActions,
     stage: xr::Space,
     frame_stream: xr::FrameStream<xr::Vulkan>,
@@ -98,7 +98,7 @@ impl XrSession {
             })
             .unwrap_or((0, 0));
         Ok(XrSession {
-            swapchain: None,
+            swapchains: None,
             actions,
             stage,
             frame_stream,
@@ -138,7 +138,7 @@ impl XrSession {
                         .map_err(xr_call("xrRequestExitSession"))?;
                 }
                 Directive::ReleaseImage => {
-                    if let Some(sc) = self.swapchain.as_mut() {
+                    for sc in self.swapchains.iter_mut().flatten() {
                         let _ = sc.handle.release_image();
                     }
                 }
@@ -269,25 +269,35 @@ impl Headset for XrSession {
     }
 
     fn acquire(&mut self) -> Result<[wgpu::TextureView; 2], XrError> {
-        if self.swapchain.is_none() {
-            self.swapchain = Some(EyeSwapchain::new(
-                &self.runtime.instance,
-                self.runtime.system,
-                &self.session,
-                &self.gpu.device,
-            )?);
+        if self.swapchains.is_none() {
+            let make = || {
+                EyeSwapchain::new(
+                    &self.runtime.instance,
+                    self.runtime.system,
+                    &self.session,
+                    &self.gpu.device,
+                )
+            };
+            self.swapchains = Some([make()?, make()?]);
         }
-        let sc = self.swapchain.as_mut().expect("created above");
-        let index = sc
-            .handle
-            .acquire_image()
-            .map_err(xr_call("xrAcquireSwapchainImage"))?;
+        let scs = self.swapchains.as_mut().expect("created above");
+        // Both eyes' images are one acquisition for the lifecycle: acquired together,
+        // released together.
+        let mut index = [0usize; 2];
+        for (i, sc) in scs.iter_mut().enumerate() {
+            index[i] = sc
+                .handle
+                .acquire_image()
+                .map_err(xr_call("xrAcquireSwapchainImage"))? as usize;
+        }
         self.lifecycle.acquire_image()?;
-        sc.handle
-            .wait_image(xr::Duration::INFINITE)
-            .map_err(xr_call("xrWaitSwapchainImage"))?;
-        self.eye_size = sc.size;
-        Ok(sc.eye_views(index as usize))
+        for sc in scs.iter_mut() {
+            sc.handle
+                .wait_image(xr::Duration::INFINITE)
+                .map_err(xr_call("xrWaitSwapchainImage"))?;
+        }
+        self.eye_size = scs[0].size;
+        Ok([scs[0].view(index[0]), scs[1].view(index[1])])
     }
 
     fn end_frame(&mut self, rendered: bool) -> Result<(), XrError> {
@@ -295,33 +305,31 @@ impl Headset for XrSession {
             .frame_state
             .ok_or_else(|| XrError::Gpu("end_frame without a frame".into()))?;
         if self.lifecycle.stage() == super::lifecycle::FrameStage::Acquired {
-            let sc = self
-                .swapchain
-                .as_mut()
-                .expect("an image was acquired from it");
-            sc.handle
-                .release_image()
-                .map_err(xr_call("xrReleaseSwapchainImage"))?;
+            for sc in self.swapchains.iter_mut().flatten() {
+                sc.handle
+                    .release_image()
+                    .map_err(xr_call("xrReleaseSwapchainImage"))?;
+            }
             self.lifecycle.release_image()?;
         }
-        let result = match (&self.swapchain, rendered) {
-            (Some(sc), true) => {
-                let rect = xr::Rect2Di {
-                    offset: xr::Offset2Di { x: 0, y: 0 },
-                    extent: xr::Extent2Di {
-                        width: sc.size.0 as i32,
-                        height: sc.size.1 as i32,
-                    },
-                };
+        let result = match (&self.swapchains, rendered) {
+            (Some(scs), true) => {
                 let views: Vec<xr::CompositionLayerProjectionView<'_, xr::Vulkan>> = (0..2)
                     .map(|i| {
+                        let rect = xr::Rect2Di {
+                            offset: xr::Offset2Di { x: 0, y: 0 },
+                            extent: xr::Extent2Di {
+                                width: scs[i].size.0 as i32,
+                                height: scs[i].size.1 as i32,
+                            },
+                        };
                         xr::CompositionLayerProjectionView::new()
                             .pose(self.views[i].pose)
                             .fov(self.views[i].fov)
                             .sub_image(
                                 xr::SwapchainSubImage::new()
-                                    .swapchain(&sc.handle)
-                                    .image_array_index(i as u32)
+                                    .swapchain(&scs[i].handle)
+                                    .image_array_index(0)
                                     .image_rect(rect),
                             )
                     })

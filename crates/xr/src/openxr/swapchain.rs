@@ -1,5 +1,8 @@
-//! The eye swapchain: one `array_size 2` OpenXR swapchain (layer 0 left, layer 1 right),
-//! each of its Vulkan images wrapped as a wgpu texture so the renderer draws into it.
+//! An eye swapchain: one OpenXR swapchain per eye (single layer), each of its Vulkan
+//! images wrapped as a wgpu texture so the renderer draws into it. One swapchain per eye
+//! rather than one two-layer swapchain: on lavapipe (wgpu 30) the renderer's second
+//! multisample resolve into layer 1 of an array texture lands in layer 0, so each eye
+//! gets a texture of its own.
 
 use ::openxr as xr;
 use ash::vk::{self, Handle};
@@ -22,7 +25,7 @@ pub struct EyeSwapchain {
 }
 
 impl EyeSwapchain {
-    /// A swapchain at the runtime's recommended eye size.
+    /// A swapchain for one eye at the runtime's recommended eye size.
     pub fn new(
         instance: &xr::Instance,
         system: xr::SystemId,
@@ -58,7 +61,7 @@ impl EyeSwapchain {
                 width: size.0,
                 height: size.1,
                 face_count: 1,
-                array_size: 2,
+                array_size: 1,
                 mip_count: 1,
             })
             .map_err(xr_call("xrCreateSwapchain"))?;
@@ -70,7 +73,7 @@ impl EyeSwapchain {
             size: wgpu::Extent3d {
                 width: size.0,
                 height: size.1,
-                depth_or_array_layers: 2,
+                depth_or_array_layers: 1,
             },
             mip_level_count: 1,
             sample_count: 1,
@@ -122,15 +125,8 @@ impl EyeSwapchain {
         })
     }
 
-    /// One view per eye (array layer) of image `index`.
-    pub fn eye_views(&self, index: usize) -> [wgpu::TextureView; 2] {
-        [0, 1].map(|layer| {
-            self.textures[index].create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: layer,
-                array_layer_count: Some(1),
-                ..Default::default()
-            })
-        })
+    /// A view of image `index`.
+    pub fn view(&self, index: usize) -> wgpu::TextureView {
+        self.textures[index].create_view(&wgpu::TextureViewDescriptor::default())
     }
 }
