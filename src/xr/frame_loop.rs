@@ -66,6 +66,8 @@ pub struct LoopOutcome {
     pub dropped_time: f64,
     /// Fewest substeps used.
     pub min_substeps_used: u32,
+    /// Times the solver failed and the scene was reset.
+    pub solver_resets: u32,
     /// How the session ended (`None`: the runtime never made it ready).
     pub exit: Option<ExitReason>,
     /// The scalpel's path, when recorded and the controller was tracked.
@@ -116,6 +118,7 @@ pub fn run_loop(
         max_haptic: 0.0,
         dropped_time: 0.0,
         min_substeps_used: nominal,
+        solver_resets: 0,
         exit: None,
         stroke: None,
         log: FrameLog::default(),
@@ -166,7 +169,17 @@ pub fn run_loop(
         let mut force = 0.0f32;
         for _ in 0..plan.sim_frames {
             xr.drive_tool(tool_pose, engaged)?;
-            let stats = xr.step()?;
+            let stats = match xr.step() {
+                Ok(s) => s,
+                Err(e) => {
+                    // The solver gave up (a tet inverted too long): the frame is rolled
+                    // back; start the scene again rather than end the trainee's session.
+                    eprintln!("xr: {e:#}; resetting the scene");
+                    out.solver_resets += 1;
+                    xr.reset()?;
+                    break;
+                }
+            };
             sim_time += sim_dt;
             force = force.max(stats.tool_force.length());
             if let (true, Some(p)) = (opts.record, tool_pose) {

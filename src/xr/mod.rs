@@ -71,6 +71,8 @@ pub struct XrReport {
     pub substeps: (u32, u32),
     /// Median and 95th-percentile wall time of rendered frames, ms.
     pub frame_ms_p50_p95: Option<(f64, f64)>,
+    /// Times the solver failed (an inverted tet) and the scene was reset.
+    pub solver_resets: u32,
     /// How the session ended.
     pub exit: String,
     /// The recorded stroke, if any.
@@ -185,6 +187,7 @@ fn run_session(
         dropped_time_s: outcome.dropped_time,
         substeps: (xr.nominal_substeps(), outcome.min_substeps_used),
         frame_ms_p50_p95: quant(0.5).zip(quant(0.95)),
+        solver_resets: outcome.solver_resets,
         exit: match outcome.exit {
             Some(e) => format!("{e:?}"),
             None => "the runtime never made the session ready".into(),
