@@ -13,7 +13,7 @@ use super::lifecycle::{Directive, Lifecycle, SessionPhase};
 use super::pose::Fov;
 use super::runtime::{Runtime, open_runtime};
 use super::swapchain::{EYE_FORMAT, EyeSwapchain};
-use super::vulkan::{XrGpu, create_gpu};
+use super::vulkan::{RuntimeVulkan, XrGpu, create_gpu};
 use crate::device::RenderDevice;
 
 const VIEW_TYPE: xr::ViewConfigurationType = xr::ViewConfigurationType::PRIMARY_STEREO;
@@ -56,7 +56,10 @@ impl XrSession {
     /// usable runtime or headset.
     pub fn open() -> Result<Self, XrError> {
         let runtime = open_runtime()?;
-        let gpu = create_gpu(&runtime.instance, runtime.system)?;
+        let gpu = create_gpu(&RuntimeVulkan {
+            instance: &runtime.instance,
+            system: runtime.system,
+        })?;
         // SAFETY: the handles are the live Vulkan instance, physical device and device
         // created through this runtime for this system; `gpu` outlives the session.
         let (session, frame_waiter, frame_stream) = unsafe {

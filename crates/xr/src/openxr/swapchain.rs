@@ -68,53 +68,21 @@ impl EyeSwapchain {
         let images = handle
             .enumerate_images()
             .map_err(xr_call("xrEnumerateSwapchainImages"))?;
-        let desc = wgpu::TextureDescriptor {
-            label: Some("xr eye swapchain"),
-            size: wgpu::Extent3d {
-                width: size.0,
-                height: size.1,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: EYE_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        };
-        let hal_desc = hal::TextureDescriptor {
-            label: Some("xr eye swapchain"),
-            size: desc.size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: EYE_FORMAT,
-            usage: wgpu::TextureUses::COLOR_TARGET | wgpu::TextureUses::RESOURCE,
-            memory_flags: hal::MemoryFlags::empty(),
-            view_formats: vec![],
-        };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let mut textures = Vec::with_capacity(images.len());
         for image in images {
             // SAFETY: the image belongs to the runtime's swapchain on this device, created
-            // with the format, size, layers and usage of `hal_desc`; the runtime owns it
-            // (a drop callback that does nothing, external memory) and the swapchain
+            // with this format, size, one layer and these usages; the runtime owns it (a
+            // drop callback that does nothing, external memory) and the swapchain
             // outlives the textures (dropped first in `XrSession`).
             let texture = unsafe {
-                let hal_device = dev
-                    .device
-                    .as_hal::<hal::api::Vulkan>()
-                    .ok_or_else(|| XrError::Gpu("the render device is not Vulkan".into()))?;
-                let raw = hal_device.texture_from_raw(
+                wrap_image(
+                    dev,
                     vk::Image::from_raw(image),
-                    &hal_desc,
-                    Some(Box::new(|| {})),
-                    hal_vk::TextureMemory::External,
-                );
-                dev.device.create_texture_from_hal::<hal::api::Vulkan>(
-                    raw,
-                    &desc,
-                    wgpu::TextureUses::UNINITIALIZED,
-                )
+                    size,
+                    usage,
+                    Box::new(|| {}),
+                )?
             };
             textures.push(texture);
         }
@@ -128,5 +96,82 @@ impl EyeSwapchain {
     /// A view of image `index`.
     pub fn view(&self, index: usize) -> wgpu::TextureView {
         self.textures[index].create_view(&wgpu::TextureViewDescriptor::default())
+    }
+}
+
+/// Wrap a Vulkan image of the render device as a wgpu texture (one layer, one mip,
+/// [`EYE_FORMAT`]) for `usage` (render attachment, texture binding, copy source).
+///
+/// # Safety
+/// `image` must be a live image of `dev`'s Vulkan device created with that format,
+/// `size`, one layer, one sample and the Vulkan usages matching `usage`; it must stay
+/// valid until `on_drop` runs (the texture does not own its memory).
+pub unsafe fn wrap_image(
+    dev: &RenderDevice,
+    image: vk::Image,
+    size: (u32, u32),
+    usage: wgpu::TextureUsages,
+    on_drop: hal::DropCallback,
+) -> Result<wgpu::Texture, XrError> {
+    let extent = wgpu::Extent3d {
+        width: size.0,
+        height: size.1,
+        depth_or_array_layers: 1,
+    };
+    let mut uses = wgpu::TextureUses::empty();
+    for (u, h) in [
+        (
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+            wgpu::TextureUses::COLOR_TARGET,
+        ),
+        (
+            wgpu::TextureUsages::TEXTURE_BINDING,
+            wgpu::TextureUses::RESOURCE,
+        ),
+        (wgpu::TextureUsages::COPY_SRC, wgpu::TextureUses::COPY_SRC),
+    ] {
+        if usage.contains(u) {
+            uses |= h;
+        }
+    }
+    let hal_desc = hal::TextureDescriptor {
+        label: Some("xr eye image"),
+        size: extent,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: EYE_FORMAT,
+        usage: uses,
+        memory_flags: hal::MemoryFlags::empty(),
+        view_formats: vec![],
+    };
+    let desc = wgpu::TextureDescriptor {
+        label: Some("xr eye image"),
+        size: extent,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: EYE_FORMAT,
+        usage,
+        view_formats: &[],
+    };
+    // SAFETY: the caller's guarantees on `image`; the texture starts uninitialised.
+    unsafe {
+        let hal_device = dev
+            .device
+            .as_hal::<hal::api::Vulkan>()
+            .ok_or_else(|| XrError::Gpu("the render device is not Vulkan".into()))?;
+        let raw = hal_device.texture_from_raw(
+            image,
+            &hal_desc,
+            Some(on_drop),
+            hal_vk::TextureMemory::External,
+        );
+        drop(hal_device);
+        Ok(dev.device.create_texture_from_hal::<hal::api::Vulkan>(
+            raw,
+            &desc,
+            wgpu::TextureUses::UNINITIALIZED,
+        ))
     }
 }
