@@ -235,3 +235,59 @@ impl XrBody {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fewer_substeps_keep_state_and_tool_and_reset_goes_back_to_rest() {
+        let dev = match RenderDevice::headless() {
+            Ok(d) => d,
+            Err(e) => {
+                eprintln!("skipping: {e}");
+                return;
+            }
+        };
+        let (mut xr, _) =
+            XrBody::load(Path::new("config/plate_cut.ron"), DeviceChoice::Cpu, &dev).unwrap();
+        let nominal = xr.nominal_substeps();
+        let min = xr.min_substeps();
+        assert!(
+            min >= 1 && min < nominal,
+            "plate_cut is stable below its {nominal} substeps: {min}"
+        );
+        // Blade resting on the top, engaged, and a few frames of sag under gravity.
+        let pose = ToolPose {
+            position: Vec3::new(0.04, 0.02, 0.021),
+            rotation: Quat::IDENTITY,
+        };
+        for _ in 0..3 {
+            xr.drive_tool(Some(pose), true).unwrap();
+            xr.step().unwrap();
+        }
+        let before = xr.solver().positions().to_vec();
+        let rest = xr.solver().mesh().rest_positions.clone();
+        let pins = pinned_nodes(xr.solver());
+        assert!(!pins.is_empty());
+        assert!(
+            before
+                .iter()
+                .zip(&rest)
+                .any(|(a, b)| (*a - *b).length() > 1e-7)
+        );
+        xr.set_substeps(min).unwrap();
+        let s = xr.solver();
+        assert_eq!(s.params().substeps, min);
+        assert_eq!(s.positions(), &before[..]);
+        assert_eq!(pinned_nodes(s), pins, "pins kept");
+        let motion = s.tool().expect("the scalpel stays attached");
+        assert_eq!(motion.to, pose);
+        xr.step().unwrap();
+        // Reset: rest positions, nominal substeps, the scalpel waiting until tracked.
+        xr.reset().unwrap();
+        assert_eq!(xr.solver().positions(), &rest[..]);
+        assert_eq!(xr.solver().params().substeps, nominal);
+        assert!(!xr.tool().1);
+    }
+}

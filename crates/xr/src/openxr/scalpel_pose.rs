@@ -106,4 +106,21 @@ mod tests {
             pose.position
         );
     }
+
+    #[test]
+    fn the_inverse_gives_back_the_grip() {
+        let tray = Tray {
+            yaw: 0.7,
+            scale: 1.5,
+            ..Tray::for_bounds(Vec3::ZERO, Vec3::splat(0.1))
+        };
+        let grip = XrPose::new(
+            Vec3::new(0.1, 1.1, -0.3),
+            Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.5, 0.2),
+        );
+        let tool = scalpel_pose(grip, BladeOffset::default(), &tray);
+        let back = grip_for_scalpel(tool, BladeOffset::default(), &tray);
+        assert!((back.position - grip.position).length() < 1e-5, "{back:?}");
+        assert!(back.orientation.dot(grip.orientation).abs() > 1.0 - 1e-6);
+    }
 }
