@@ -14,7 +14,7 @@ use incise_xr::openxr::controls::{ControllerState, commands};
 use incise_xr::openxr::eye::eye_view;
 use incise_xr::openxr::haptics::haptic_pulse;
 use incise_xr::openxr::lifecycle::ExitReason;
-use incise_xr::openxr::pacing::{FramePacer, FramePlan, PacingConfig};
+use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
 use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{FrameEvent, Headset};
@@ -188,7 +188,7 @@ pub fn run_loop(
         }
         let sim_ms = sim_start.elapsed().as_secs_f64() * 1e3;
         if plan.sim_frames > 0 {
-            pacer.record(FramePlan { ..plan }, sim_ms * 1e-3);
+            pacer.record(plan, sim_ms * 1e-3);
             out.min_substeps_used = out.min_substeps_used.min(plan.substeps);
         }
         out.sim_frames += plan.sim_frames as u64;

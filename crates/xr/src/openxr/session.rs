@@ -202,6 +202,19 @@ impl XrSession {
     }
 }
 
+impl Drop for XrSession {
+    /// Let the GPU finish and release the wrapped swapchain textures (and their views)
+    /// while the runtime's swapchain images still exist; the fields then drop in order.
+    fn drop(&mut self) {
+        let device = &self.gpu.device.device;
+        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+        for sc in self.swapchains.iter_mut().flatten() {
+            sc.textures.clear();
+        }
+        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
 impl Headset for XrSession {
     fn device(&self) -> &RenderDevice {
         &self.gpu.device
