@@ -118,6 +118,36 @@ fn simulated_headset_renders_both_eyes_and_the_controller_stroke_cuts() {
         assert!((0.01..0.06).contains(&k.position.x), "{:?}", k.position);
     }
 
+    // The trainee's stroke replays headless (`incise run --stroke`) to a cut of the same
+    // size (the same tool path through the same solver; the session's frame timing
+    // differs slightly).
+    let o = incise(&[
+        "run",
+        "config/plate_cut.ron",
+        "--stroke",
+        out.join("stroke.ron").to_str().unwrap(),
+        "--out",
+        out.join("replay").to_str().unwrap(),
+        "--vtu-every",
+        "0",
+        "--device",
+        "cpu",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let summary = text(&o.stdout);
+    let replayed: f64 = summary
+        .split_whitespace()
+        .zip(summary.split_whitespace().skip(1))
+        .find(|(_, w)| *w == "tets")
+        .and_then(|(n, _)| n.parse().ok())
+        .unwrap_or_else(|| panic!("no tet count in {summary}"));
+    let live = r["released_tets"].as_f64().unwrap();
+    assert!(
+        (replayed - live).abs() <= 0.1 * live,
+        "replay {replayed} vs session {live}"
+    );
+
     // Both eyes at Quest 3 size, showing the slab with the disparity of a 63 mm IPD.
     let left = RgbaImage::load_png(&out.join("eye_left_00000.png")).unwrap();
     let right = RgbaImage::load_png(&out.join("eye_right_00000.png")).unwrap();
