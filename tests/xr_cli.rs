@@ -152,6 +152,7 @@ fn simulated_headset_renders_both_eyes_and_the_controller_stroke_cuts() {
     let left = RgbaImage::load_png(&out.join("eye_left_00000.png")).unwrap();
     let right = RgbaImage::load_png(&out.join("eye_right_00000.png")).unwrap();
     assert_eq!((left.width, left.height), (2064, 2208));
+    assert_eq!(left.get(0, 0)[3], 255, "opaque room without passthrough");
     let (lx, ly, ln) = centroid(&left);
     let (rx, ry, rn) = centroid(&right);
     assert!(
@@ -208,4 +209,27 @@ fn with_the_trigger_released_the_blade_pushes_but_does_not_cut() {
         Some(0.0),
         "no vibration while disengaged: {r}"
     );
+}
+
+/// With passthrough the eye images are transparent around the organ (the room shows
+/// through) and opaque on it.
+#[test]
+fn with_passthrough_the_room_shows_around_the_organ() {
+    let (out, r) = run_simulated(
+        "xr-sim-passthrough",
+        "(duration: 0.03, eye_size: (320, 320), passthrough: true, screenshots: [0], \
+         head: [(t: 0.0, position: (0.0, 1.25, -0.05), orientation: (-0.34202, 0.0, 0.0, 0.93969))])",
+    );
+    assert_eq!(r["exit"], "Exited");
+    let eye = RgbaImage::load_png(&out.join("eye_left_00000.png")).unwrap();
+    assert_eq!(
+        eye.get(0, 0),
+        [0, 0, 0, 0],
+        "transparent, premultiplied background"
+    );
+    let opaque = (0..eye.height)
+        .flat_map(|y| (0..eye.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| eye.get(x, y)[3] == 255)
+        .count();
+    assert!(opaque > 30, "the organ is opaque: {opaque} pixels");
 }

@@ -123,6 +123,7 @@ pub fn run_loop(
         stroke: None,
         log: FrameLog::default(),
     };
+    let (background, background_alpha) = headset.backdrop().clear();
     let mut idle = 0;
     let mut exit_asked = false;
     loop {
@@ -222,6 +223,8 @@ pub fn run_loop(
                     stress,
                     ..Default::default()
                 },
+                background,
+                background_alpha,
                 ..RenderSettings::default()
             };
             let mut enc = dev

@@ -91,11 +91,7 @@ pub fn run(opts: &XrOptions) -> Result<XrReport> {
                     anyhow::Error::new(e).context("starting the OpenXR session")
                 }
             })?;
-            if session.passthrough_available() {
-                eprintln!(
-                    "note: the runtime offers XR_FB_passthrough; this build shows the opaque room"
-                );
-            }
+            eprintln!("xr: backdrop {:?}", session.backdrop());
             let dev = session.device().clone();
             let (mut xr, skin) = XrBody::load(&opts.scene, opts.device, &dev)?;
             let tray = tray_for(&xr);

@@ -42,6 +42,10 @@ pub struct HeadsetScript {
     /// Display frames whose two eye images are saved as PNGs.
     #[serde(default)]
     pub screenshots: Vec<u64>,
+    /// Show the room through passthrough (the eye images are transparent around the
+    /// organ) instead of the opaque neutral room.
+    #[serde(default)]
+    pub passthrough: bool,
     /// How substeps are paced.
     #[serde(default)]
     pub pacing: Pacing,

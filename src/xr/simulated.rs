@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use glam::Vec2;
 use incise_scalpel::Stroke;
+use incise_xr::openxr::backdrop::Backdrop;
 use incise_xr::openxr::controls::ControllerState;
 use incise_xr::openxr::haptics::HapticPulse;
 use incise_xr::openxr::lifecycle::{FrameStage, Lifecycle, SessionPhase};
@@ -174,6 +175,14 @@ impl Headset for SimulatedHeadset {
 
     fn eye_size(&self) -> (u32, u32) {
         self.script.eye_size
+    }
+
+    fn backdrop(&self) -> Backdrop {
+        if self.script.passthrough {
+            Backdrop::Passthrough
+        } else {
+            Backdrop::Opaque
+        }
     }
 
     fn format(&self) -> wgpu::TextureFormat {

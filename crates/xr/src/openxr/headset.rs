@@ -2,6 +2,7 @@
 //! and the simulated headset: frames with predicted display times, eye poses and fields
 //! of view, controller state, eye render targets, and vibration.
 
+use super::backdrop::Backdrop;
 use super::controls::ControllerState;
 use super::error::XrError;
 use super::haptics::HapticPulse;
@@ -47,6 +48,8 @@ pub trait Headset {
     fn format(&self) -> wgpu::TextureFormat;
     /// What this headset is (runtime name, or "simulated").
     fn describe(&self) -> String;
+    /// What the organ is seen against (sets the eye images' clear colour and alpha).
+    fn backdrop(&self) -> Backdrop;
     /// Poll events, wait for the next frame and begin it.
     fn next_frame(&mut self) -> Result<FrameEvent, XrError>;
     /// Acquire the begun frame's eye targets: one view per eye in eye order.

@@ -4,12 +4,14 @@
 //! Pure frame logic, tested without a runtime: [`pose`] (axes), [`eye`] (view and
 //! projection from `XrView`), [`tray`] (placement), [`scalpel_pose`] (controller → blade),
 //! [`haptics`], [`pacing`] (fixed simulation dt, substeps cut before time),
-//! [`lifecycle`] (session states and the frame in flight), [`bindings`] and [`controls`].
+//! [`lifecycle`] (session states and the frame in flight), [`bindings`], [`controls`] and
+//! [`backdrop`] (passthrough, alpha blend or an opaque room).
 //! Runtime side: [`runtime`] (loader, instance, headset), [`vulkan`] (Vulkan through the
-//! runtime, wrapped into wgpu), [`swapchain`], [`actions`], [`session`]. The frame loop
+//! runtime, wrapped into wgpu), [`swapchain`], [`actions`], [`passthrough`], [`session`]. The frame loop
 //! drives any [`headset::Headset`]: the OpenXR session or the app's simulated headset.
 
 pub mod actions;
+pub mod backdrop;
 pub mod bindings;
 pub mod controls;
 pub mod error;
@@ -18,6 +20,7 @@ pub mod haptics;
 pub mod headset;
 pub mod lifecycle;
 pub mod pacing;
+pub mod passthrough;
 pub mod pose;
 pub mod runtime;
 pub mod scalpel_pose;

@@ -3,6 +3,7 @@
 
 use ::openxr as xr;
 
+use super::backdrop::Backdrop;
 use super::error::{XrError, xr_call};
 
 /// An OpenXR instance on a runtime with a head-mounted display.
@@ -13,9 +14,9 @@ pub struct Runtime {
     pub system: xr::SystemId,
     /// "name version" of the runtime.
     pub name: String,
-    /// Whether `XR_FB_passthrough` is offered (the room can show behind the organ).
-    pub passthrough_available: bool,
-    /// The environment blend mode used (opaque unless the display is see-through).
+    /// What the organ is seen against.
+    pub backdrop: Backdrop,
+    /// The environment blend mode submitted with each frame.
     pub blend_mode: xr::EnvironmentBlendMode,
 }
 
@@ -37,6 +38,7 @@ pub fn open_runtime() -> Result<Runtime, XrError> {
     };
     let mut wanted = xr::ExtensionSet::default();
     wanted.khr_vulkan_enable2 = available.khr_vulkan_enable2;
+    wanted.fb_passthrough = available.fb_passthrough;
     let instance = entry
         .create_instance(&app, &wanted, &[], &())
         .map_err(|e| match e {
@@ -64,19 +66,23 @@ pub fn open_runtime() -> Result<Runtime, XrError> {
     let modes = instance
         .enumerate_environment_blend_modes(system, xr::ViewConfigurationType::PRIMARY_STEREO)
         .map_err(xr_call("xrEnumerateEnvironmentBlendModes"))?;
-    let blend_mode = if modes.contains(&xr::EnvironmentBlendMode::OPAQUE) {
-        xr::EnvironmentBlendMode::OPAQUE
-    } else {
-        modes
+    let backdrop = Backdrop::choose(
+        available.fb_passthrough,
+        modes.contains(&xr::EnvironmentBlendMode::ALPHA_BLEND),
+    );
+    let blend_mode = match backdrop {
+        Backdrop::AlphaBlend => xr::EnvironmentBlendMode::ALPHA_BLEND,
+        _ if modes.contains(&xr::EnvironmentBlendMode::OPAQUE) => xr::EnvironmentBlendMode::OPAQUE,
+        _ => modes
             .first()
             .copied()
-            .unwrap_or(xr::EnvironmentBlendMode::OPAQUE)
+            .unwrap_or(xr::EnvironmentBlendMode::OPAQUE),
     };
     Ok(Runtime {
         instance,
         system,
         name,
-        passthrough_available: available.fb_passthrough,
+        backdrop,
         blend_mode,
     })
 }

@@ -6,10 +6,12 @@
 use ::openxr as xr;
 
 use super::actions::{XrActions, to_pose};
+use super::backdrop::Backdrop;
 use super::error::{XrError, xr_call};
 use super::haptics::HapticPulse;
 use super::headset::{FrameEvent, Headset, HeadsetFrame};
 use super::lifecycle::{Directive, Lifecycle, SessionPhase};
+use super::passthrough::XrPassthrough;
 use super::pose::Fov;
 use super::runtime::{Runtime, open_runtime};
 use super::swapchain::{EYE_FORMAT, EyeSwapchain};
@@ -22,6 +24,7 @@ const VIEW_TYPE: xr::ViewConfigurationType = xr::ViewConfigurationType::PRIMARY_
 /// swapchains, the session before the device, the instance last.
 pub struct XrSession {
     swapchains: Option<[EyeSwapchain; 2]>,
+    passthrough: Option<XrPassthrough>,
     actions: XrActions,
     stage: xr::Space,
     frame_stream: xr::FrameStream<xr::Vulkan>,
@@ -87,6 +90,10 @@ impl XrSession {
             .create_reference_space(space_type, xr::Posef::IDENTITY)
             .map_err(xr_call("xrCreateReferenceSpace"))?;
         let actions = XrActions::new(&runtime.instance, &session)?;
+        let passthrough = match runtime.backdrop {
+            Backdrop::Passthrough => Some(XrPassthrough::start(&session)?),
+            _ => None,
+        };
         let eye = runtime
             .instance
             .enumerate_view_configuration_views(runtime.system, VIEW_TYPE)
@@ -102,6 +109,7 @@ impl XrSession {
             .unwrap_or((0, 0));
         Ok(XrSession {
             swapchains: None,
+            passthrough,
             actions,
             stage,
             frame_stream,
@@ -115,11 +123,6 @@ impl XrSession {
             views: Vec::new(),
             eye_size,
         })
-    }
-
-    /// Whether the runtime offers `XR_FB_passthrough`.
-    pub fn passthrough_available(&self) -> bool {
-        self.runtime.passthrough_available
     }
 
     /// Make the calls the lifecycle asks for. Calls on a session being lost may fail;
@@ -226,6 +229,10 @@ impl Headset for XrSession {
 
     fn format(&self) -> wgpu::TextureFormat {
         EYE_FORMAT
+    }
+
+    fn backdrop(&self) -> Backdrop {
+        self.runtime.backdrop
     }
 
     fn describe(&self) -> String {
@@ -350,14 +357,29 @@ impl Headset for XrSession {
                             )
                     })
                     .collect();
-                let layer = xr::CompositionLayerProjection::new()
+                let mut layer = xr::CompositionLayerProjection::new()
                     .space(&self.stage)
                     .views(&views);
-                self.frame_stream.end(
-                    fs.predicted_display_time,
-                    self.runtime.blend_mode,
-                    &[&layer],
-                )
+                if self.runtime.backdrop != Backdrop::Opaque {
+                    // The eye images are transparent where the room shows (premultiplied).
+                    layer =
+                        layer.layer_flags(xr::CompositionLayerFlags::BLEND_TEXTURE_SOURCE_ALPHA);
+                }
+                match &self.passthrough {
+                    Some(p) => {
+                        let room = p.composition_layer();
+                        self.frame_stream.end(
+                            fs.predicted_display_time,
+                            self.runtime.blend_mode,
+                            &[room.base(), &layer],
+                        )
+                    }
+                    None => self.frame_stream.end(
+                        fs.predicted_display_time,
+                        self.runtime.blend_mode,
+                        &[&layer],
+                    ),
+                }
             }
             _ => self
                 .frame_stream
