@@ -85,6 +85,29 @@ pub enum Command {
         #[arg(long, default_value = "1280x800")]
         size: ImageSize,
     },
+    /// The scene on a tray in the room of an OpenXR headset (Meta Quest 3 over Link,
+    /// WiVRn/Monado), cut with the right controller; exits 2 when no runtime or headset
+    /// is usable. `--simulated-headset` runs the same frame loop on a scripted headset.
+    Xr {
+        /// Scene file (RON); default config/plate_cut.ron.
+        scene: Option<PathBuf>,
+        /// Run without a runtime on this headset script (RON: head, controller and
+        /// button tracks), rendering both eyes offscreen.
+        #[arg(long)]
+        simulated_headset: Option<PathBuf>,
+        /// Output folder: frames.csv (frame times), xr_report.json, stroke.ron, eye PNGs.
+        #[arg(long, default_value = "out/xr")]
+        out: PathBuf,
+        /// Also write the recorded scalpel stroke here (replay: `incise run --stroke`).
+        #[arg(long)]
+        record_stroke: Option<PathBuf>,
+        /// Stop after this many display frames.
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Where the solver runs (auto: the headset's GPU; the CPU for a simulated one).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+    },
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {
         /// Scene file (RON).

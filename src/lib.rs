@@ -19,3 +19,4 @@ pub mod run_rheology;
 pub mod scene;
 pub mod screenshots;
 pub mod soak;
+pub mod xr;

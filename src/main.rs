@@ -12,6 +12,9 @@ use incise::{bench, bench_render, compare, exercise, experiment, mesh_cmd, scree
 /// The scene opened when none is named.
 const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
 
+/// The scene `incise xr` opens when none is named.
+const XR_SCENE: &str = "config/plate_cut.ron";
+
 /// No subcommand: the preview of the default scene when a window can open, else the
 /// headless run of it (as scripts/run.sh), saying so.
 fn default_command() -> Command {
@@ -99,6 +102,22 @@ fn main() -> ExitCode {
             device,
             size,
         }),
+        Command::Xr {
+            scene,
+            simulated_headset,
+            out,
+            record_stroke,
+            frames,
+            device,
+        } => incise::xr::run(&incise::xr::XrOptions {
+            scene: scene.unwrap_or_else(|| XR_SCENE.into()),
+            simulated: simulated_headset,
+            out,
+            record_stroke,
+            frames,
+            device,
+        })
+        .map(|r| println!("{}", r.summary())),
         Command::Render {
             scene,
             frame,
@@ -219,6 +238,11 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<incise::xr::XrUnavailable>().is_some() => {
+            // No usable OpenXR runtime or headset: not a failure of incise (exit 2).
+            eprintln!("{e}");
+            ExitCode::from(2)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
