@@ -24,13 +24,15 @@ const SLACK: usize = 64 * 1024;
 
 /// Seed files written by our own writers from a 2 × 2 × 2-cell block, plus Gmsh samples
 /// (made once per process: the tests run in parallel and would race on the files).
-fn seeds() -> Vec<(&'static str, Vec<Vec<u8>>)> {
-    static SEEDS: std::sync::OnceLock<Vec<(&'static str, Vec<Vec<u8>>)>> =
-        std::sync::OnceLock::new();
+fn seeds() -> Seeds {
+    static SEEDS: std::sync::OnceLock<Seeds> = std::sync::OnceLock::new();
     SEEDS.get_or_init(make_seeds).clone()
 }
 
-fn make_seeds() -> Vec<(&'static str, Vec<Vec<u8>>)> {
+/// Seed files per format name.
+type Seeds = Vec<(&'static str, Vec<Vec<u8>>)>;
+
+fn make_seeds() -> Seeds {
     let dir = std::env::temp_dir().join(format!("incise-fuzz-seeds-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mesh = common::block_mesh(Vec3::ZERO, Vec3::splat(0.01), UVec3::new(2, 2, 2));
