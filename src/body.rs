@@ -46,6 +46,30 @@ impl Body {
         }
     }
 
+    /// The CPU solver from here on: a GPU body gives up its host mirror (the state of the
+    /// last completed frame), a CPU body stays as it is.
+    pub fn into_cpu(self) -> Body {
+        match self {
+            Body::Gpu(g) => Body::Cpu(Box::new(g.into_host())),
+            cpu => cpu,
+        }
+    }
+
+    /// Fault injection for tests: lose the GPU device (no effect on the CPU).
+    pub fn inject_device_loss(&self) {
+        if let Body::Gpu(g) = self {
+            g.inject_device_loss();
+        }
+    }
+
+    /// Fault injection for tests: a NaN velocity on free node `node`.
+    pub fn inject_non_finite(&mut self, node: usize) {
+        match self {
+            Body::Cpu(s) => s.inject_non_finite(node),
+            Body::Gpu(g) => g.inject_non_finite(node),
+        }
+    }
+
     /// Advance one frame.
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
         match self {

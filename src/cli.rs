@@ -59,6 +59,14 @@ pub enum Command {
         /// Record the scalpel's pose every frame to this stroke file.
         #[arg(long)]
         record_stroke: Option<PathBuf>,
+        /// Testing aid: destroy the GPU device just before frame N (the run must go on
+        /// on the CPU with a warning in report.json).
+        #[arg(long, value_name = "N")]
+        inject_gpu_loss_at: Option<u64>,
+        /// Testing aid: give a node a NaN velocity just before frame N (the run must stop
+        /// with the frame and tet named, the frame rolled back, the output kept).
+        #[arg(long, value_name = "N")]
+        inject_nan_at: Option<u64>,
     },
     /// Open the desktop preview: the scene in a window with a control panel.
     Preview {
@@ -76,6 +84,29 @@ pub enum Command {
         /// Window size, WIDTHxHEIGHT.
         #[arg(long, default_value = "1280x800")]
         size: ImageSize,
+    },
+    /// The scene on a tray in the room of an OpenXR headset (Meta Quest 3 over Link,
+    /// WiVRn/Monado), cut with the right controller; exits 2 when no runtime or headset
+    /// is usable. `--simulated-headset` runs the same frame loop on a scripted headset.
+    Xr {
+        /// Scene file (RON); default config/plate_cut.ron.
+        scene: Option<PathBuf>,
+        /// Run without a runtime on this headset script (RON: head, controller and
+        /// button tracks), rendering both eyes offscreen.
+        #[arg(long)]
+        simulated_headset: Option<PathBuf>,
+        /// Output folder: frames.csv (frame times), xr_report.json, stroke.ron, eye PNGs.
+        #[arg(long, default_value = "out/xr")]
+        out: PathBuf,
+        /// Also write the recorded scalpel stroke here (replay: `incise run --stroke`).
+        #[arg(long)]
+        record_stroke: Option<PathBuf>,
+        /// Stop after this many display frames.
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Where the solver runs (auto: the headset's GPU; the CPU for a simulated one).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
     },
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {
@@ -137,6 +168,57 @@ pub enum Command {
         /// Add the intestine scaling series (≈140k, 550k, 1.1M tets).
         #[arg(long)]
         scaling: bool,
+    },
+    /// Endurance run: cut a scalpel scene, reset, cut again for a wall-clock duration;
+    /// fails (exit 1) if memory grows > 5 %, file descriptors leak or a cut differs.
+    Soak {
+        /// Scene file with a tool and a stroke, e.g. config/plate_cut.ron.
+        scene: PathBuf,
+        /// Wall-clock duration in seconds (at least three cuts are made).
+        #[arg(long, default_value_t = 3600.0)]
+        seconds: f64,
+        /// Where the solver runs.
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+        /// Output folder for soak.json.
+        #[arg(long, default_value = "out/soak")]
+        out: PathBuf,
+    },
+    /// Score a stroke on a training exercise: runs the exercise's scene with the stroke
+    /// driving the scalpel, writes DIR/result.json and DIR/report.html and appends the
+    /// attempt to the results history.
+    Exercise {
+        /// Exercise file (RON), e.g. config/exercises/slab_depth.ron.
+        exercise: PathBuf,
+        /// Stroke file (RON timed poses: recorded with `incise run --record-stroke`, or
+        /// scripted).
+        #[arg(long, required_unless_present = "reference_stroke")]
+        stroke: Option<PathBuf>,
+        /// Instead of scoring, write the exercise's reference stroke (the scene's scalpel
+        /// along the plan at the target depth, handle raised `--tilt`) to this file.
+        #[arg(long, conflicts_with = "stroke")]
+        reference_stroke: Option<PathBuf>,
+        /// Reference stroke: angle of the blade's spine above the surface, degrees.
+        #[arg(long, default_value_t = 30.0)]
+        tilt: f32,
+        /// Output folder.
+        #[arg(long, default_value = "out/exercise")]
+        out: PathBuf,
+        /// Where the solver runs (auto: the GPU when an adapter exists, else the CPU).
+        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+        device: DeviceChoice,
+        /// Results history the attempt is appended to (one JSON line per attempt).
+        #[arg(long, default_value = "results/history.jsonl")]
+        history: PathBuf,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Print the results history as a table, oldest attempt first.
+    Results {
+        /// Results history file.
+        #[arg(long, default_value = "results/history.jsonl")]
+        history: PathBuf,
     },
     /// Reproducible experiments that write the CSV tables and PNG figures of docs/experiments/.
     Experiment {

@@ -7,10 +7,13 @@ use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
 use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
 use incise::screenshots::ImageSize;
-use incise::{bench, bench_render, compare, experiment, mesh_cmd, screenshots};
+use incise::{bench, bench_render, compare, exercise, experiment, mesh_cmd, screenshots};
 
 /// The scene opened when none is named.
 const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
+
+/// The scene `incise xr` opens when none is named.
+const XR_SCENE: &str = "config/plate_cut.ron";
 
 /// No subcommand: the preview of the default scene when a window can open, else the
 /// headless run of it (as scripts/run.sh), saying so.
@@ -40,6 +43,8 @@ fn default_command() -> Command {
                 haptic_rate: None,
                 stroke: None,
                 record_stroke: None,
+                inject_gpu_loss_at: None,
+                inject_nan_at: None,
             }
         }
     }
@@ -62,6 +67,8 @@ fn main() -> ExitCode {
             haptic_rate,
             stroke,
             record_stroke,
+            inject_gpu_loss_at,
+            inject_nan_at,
         } => run_scene(&RunOptions {
             scene,
             frames,
@@ -75,6 +82,8 @@ fn main() -> ExitCode {
             haptic_rate,
             stroke,
             record_stroke,
+            inject_gpu_loss_at,
+            inject_nan_at,
         })
         .map(|o| {
             println!("{}", o.report.summary());
@@ -93,6 +102,22 @@ fn main() -> ExitCode {
             device,
             size,
         }),
+        Command::Xr {
+            scene,
+            simulated_headset,
+            out,
+            record_stroke,
+            frames,
+            device,
+        } => incise::xr::run(&incise::xr::XrOptions {
+            scene: scene.unwrap_or_else(|| XR_SCENE.into()),
+            simulated: simulated_headset,
+            out,
+            record_stroke,
+            frames,
+            device,
+        })
+        .map(|r| println!("{}", r.summary())),
         Command::Render {
             scene,
             frame,
@@ -126,6 +151,71 @@ fn main() -> ExitCode {
             device,
             scaling,
         } => bench::run(case, frames, json, device, scaling),
+        Command::Soak {
+            scene,
+            seconds,
+            device,
+            out,
+        } => incise::soak::run(&incise::soak::SoakOptions {
+            scene,
+            seconds,
+            device,
+            out: out.clone(),
+        })
+        .and_then(|r| {
+            let last = r.cycles.last();
+            println!(
+                "{} cuts in {:.0} s on {}: memory {:+.1} %, descriptors {:+}, p99 frame {:.1} ms (last cut), every cut {} the first",
+                r.cycles.len(),
+                r.seconds,
+                r.device,
+                r.rss_growth * 100.0,
+                r.fd_growth,
+                last.map_or(0.0, |c| c.p99_ms),
+                if r.problems.iter().any(|p| p.contains("other tets")) { "differs from" } else { "matches" },
+            );
+            println!("report: {}", out.join("soak.json").display());
+            if r.passed {
+                Ok(())
+            } else {
+                Err(anyhow::anyhow!("soak failed: {}", r.problems.join("; ")))
+            }
+        }),
+        Command::Exercise {
+            exercise,
+            reference_stroke: Some(file),
+            tilt,
+            ..
+        } => exercise::write_reference_stroke(&exercise, &file, tilt).map(|()| {
+            println!("wrote {}", file.display());
+        }),
+        Command::Exercise {
+            exercise,
+            stroke: Some(stroke),
+            out,
+            device,
+            history,
+            quiet,
+            ..
+        } => exercise::run_exercise(&exercise::ExerciseOptions {
+            exercise,
+            stroke,
+            out,
+            device,
+            history: history.clone(),
+            quiet,
+        })
+        .map(|a| {
+            println!("{}", a.result.summary());
+            println!("result: {}", a.result_path.display());
+            println!("report: {}", a.html_path.display());
+            println!("history: {}", history.display());
+        }),
+        Command::Exercise { .. } => Err(anyhow::anyhow!(
+            "incise exercise needs --stroke FILE (or --reference-stroke FILE)"
+        )),
+        Command::Results { history } => exercise::read_history(&history)
+            .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {
             ExperimentCommand::Rheology { out, presets } => {
                 experiment::rheology::run(&experiment::rheology::RheologyOptions { out, presets })
@@ -148,6 +238,11 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<incise::xr::XrUnavailable>().is_some() => {
+            // No usable OpenXR runtime or headset: not a failure of incise (exit 2).
+            eprintln!("{e}");
+            ExitCode::from(2)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

@@ -118,6 +118,8 @@ pub struct Report {
     /// The scalpel, when the scene has one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tool: Option<ToolInfo>,
+    /// What went wrong but did not stop the run (e.g. a GPU lost and the CPU taking over).
+    pub warnings: Vec<String>,
     /// Tets released by the end of the run (mesh indices, ascending).
     pub released_tets: Vec<u32>,
     /// Per-frame records.

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
+use incise_sim::xpbd::SolverError;
 
 use crate::body::{Body, DeviceChoice};
 use crate::progress::Progress;
@@ -43,6 +44,10 @@ pub struct RunOptions {
     /// Record the tool's pose at every frame to this stroke file (replayable with
     /// `--stroke`, bit for bit).
     pub record_stroke: Option<PathBuf>,
+    /// Fault injection for tests: lose the GPU device just before this frame.
+    pub inject_gpu_loss_at: Option<u64>,
+    /// Fault injection for tests: a NaN velocity on the first free node before this frame.
+    pub inject_nan_at: Option<u64>,
 }
 
 /// What a finished run produced.
@@ -183,6 +188,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
             stroke_duration: stroke.duration(),
         }),
         released_tets: Vec::new(),
+        warnings: Vec::new(),
         frames: Vec::with_capacity(frames as usize),
         snapshots: Vec::new(),
         rheology: None,
@@ -209,7 +215,32 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
                 r.push(time, pose)?;
             }
         }
-        match body.step_frame() {
+        if opts.inject_gpu_loss_at == Some(f) {
+            body.inject_device_loss();
+        }
+        if opts.inject_nan_at == Some(f) {
+            let kinds = body.solver().node_kinds();
+            if let Some(node) = kinds
+                .iter()
+                .position(|k| *k == incise_sim::xpbd::NodeKind::Free)
+            {
+                body.inject_non_finite(node);
+            }
+        }
+        let mut stepped = body.step_frame();
+        if let Err(SolverError::Device(msg)) = &stepped {
+            let warning = format!(
+                "frame {f}: the GPU failed ({msg}); continuing on the CPU from the last completed frame"
+            );
+            if !opts.quiet {
+                eprintln!("warning: {warning}");
+            }
+            report.warnings.push(warning);
+            body = body.into_cpu();
+            report.device = format!("{} (after a GPU failure)", body.device());
+            stepped = body.step_frame();
+        }
+        match stepped {
             Ok(stats) => {
                 let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
                 if let Some(p) = &progress {

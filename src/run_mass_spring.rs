@@ -75,6 +75,7 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
     let mut report = Report {
         tool: None,
         released_tets: Vec::new(),
+        warnings: Vec::new(),
         scene: scene.name.clone(),
         scene_file: opts.scene.display().to_string(),
         model: "mass-spring".into(),

@@ -143,6 +143,7 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
     let mut report = Report {
         tool: None,
         released_tets: Vec::new(),
+        warnings: Vec::new(),
         scene: scene.name.clone(),
         scene_file: opts.scene.display().to_string(),
         model: "rheology".into(),

@@ -21,11 +21,9 @@ fn released(r: &Value) -> Vec<u64> {
         .collect()
 }
 
-#[test]
-fn scripted_incision_cuts_reports_force_and_replays_exactly() {
-    let dir = temp_dir("scalpel-incision");
-    let first = dir.join("first");
-    let rec = dir.join("stroke.ron");
+/// 120 frames of `config/plate_cut.ron` on the CPU into `out`, recording (`--record-stroke`)
+/// or replaying (`--stroke`) `stroke`.
+fn cut_plate(out: &std::path::Path, flag: &str, stroke: &std::path::Path) {
     let o = incise(&[
         "run",
         "config/plate_cut.ron",
@@ -37,11 +35,19 @@ fn scripted_incision_cuts_reports_force_and_replays_exactly() {
         "0",
         "--quiet",
         "--out",
-        first.to_str().unwrap(),
-        "--record-stroke",
-        rec.to_str().unwrap(),
+        out.to_str().unwrap(),
+        flag,
+        stroke.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
+}
+
+#[test]
+fn scripted_incision_cuts_reports_force_and_replays_exactly() {
+    let dir = temp_dir("scalpel-incision");
+    let first = dir.join("first");
+    let rec = dir.join("stroke.ron");
+    cut_plate(&first, "--record-stroke", &rec);
     let r = report(&first);
     assert_eq!(r["tool"]["name"], "scalpel_10");
     let cut = released(&r);
@@ -62,22 +68,7 @@ fn scripted_incision_cuts_reports_force_and_replays_exactly() {
     assert!(amp > 0.0 && amp <= 1.0, "haptic amplitude {amp}");
     // Replay the recorded stroke: the same tets, bit for bit.
     let second = dir.join("second");
-    let o = incise(&[
-        "run",
-        "config/plate_cut.ron",
-        "--device",
-        "cpu",
-        "--frames",
-        "120",
-        "--vtu-every",
-        "0",
-        "--quiet",
-        "--out",
-        second.to_str().unwrap(),
-        "--stroke",
-        rec.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    cut_plate(&second, "--stroke", &rec);
     assert_eq!(
         released(&report(&second)),
         cut,

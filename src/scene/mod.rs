@@ -14,7 +14,7 @@ pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
     StrokeSpec,
 };
-pub use tool::{IncisionSpec, ToolSpec, ToolStroke};
+pub use tool::{IncisionSpec, ToolSpec, ToolStroke, incision};
 
 use glam::{UVec3, Vec3};
 use incise_sim::Material;

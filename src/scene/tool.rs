@@ -44,6 +44,14 @@ pub struct IncisionSpec {
     /// Height above the surface where the blade starts and finishes, m.
     #[serde(default = "default_approach")]
     pub approach: f32,
+    /// Elevation of the handle above the surface, degrees (the blade tilts in its own
+    /// plane; a No. 10 is drawn at about 30–45°).
+    #[serde(default = "default_angle")]
+    pub angle_deg: f32,
+}
+
+fn default_angle() -> f32 {
+    40.0
 }
 
 fn default_speed() -> f32 {
@@ -70,15 +78,27 @@ pub fn load(tool: &ToolSpec, stroke: &ToolStroke, scene_path: &Path) -> Result<(
 }
 
 /// The stroke of a straight incision with this tool: the blade stands vertical in the
-/// plane of the line, handle towards `end`; the tip rides high enough that the edge's
-/// lowest point reaches `depth`.
+/// plane of the line, handle towards `end` and raised by `angle_deg`; the tip rides high
+/// enough that the edge's lowest point reaches `depth`.
 pub fn incision(tool: &Tool, spec: &IncisionSpec) -> Result<Stroke> {
     let dir = (spec.end - spec.start) * Vec3::new(1.0, 1.0, 0.0);
     if dir.length() < 1e-6 {
         bail!("start and end must differ horizontally");
     }
-    let rotation = Quat::from_rotation_arc(Vec3::X, dir.normalize());
-    let drop = -tool.edge().iter().map(|p| p.y).fold(0.0, f32::min);
+    if !(spec.angle_deg.is_finite() && (0.0..90.0).contains(&spec.angle_deg)) {
+        bail!(
+            "angle_deg must be in [0, 90) degrees, got {}",
+            spec.angle_deg
+        );
+    }
+    // Pitch about the blade normal so that +x (towards the handle) rises, then yaw.
+    let pitch = Quat::from_rotation_y(-spec.angle_deg.to_radians());
+    let rotation = Quat::from_rotation_arc(Vec3::X, dir.normalize()) * pitch;
+    let drop = -tool
+        .edge()
+        .iter()
+        .map(|p| (rotation * Vec3::new(p.x, 0.0, p.y)).z)
+        .fold(0.0, f32::min);
     let lift = Vec3::Z * drop;
     let i = Incision {
         start: spec.start + lift,

@@ -25,3 +25,10 @@ pub fn temp_dir(name: &str) -> PathBuf {
 pub fn text(o: &[u8]) -> String {
     String::from_utf8_lossy(o).into_owned()
 }
+
+/// A `Command` for the built `incise` binary in the workspace root (to spawn and kill).
+pub fn incise_command(args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_incise"));
+    c.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}

@@ -12,6 +12,14 @@ use glam::{UVec3, Vec3};
 use incise_sim::SolverParams;
 use incise_sim::gpu::GpuSolver;
 
+/// Largest distance between matching nodes of two position sets, m.
+fn worst_gap(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (*p - *q).length())
+        .fold(0.0, f32::max)
+}
+
 #[test]
 fn gpu_matches_cpu_on_a_tearing_bar() {
     let Some(ctx) = common::gpu_context() else {
@@ -27,12 +35,7 @@ fn gpu_matches_cpu_on_a_tearing_bar() {
     for frame in 0..60 {
         let a = cpu.step_frame().unwrap();
         let b = gpu.step_frame().unwrap();
-        let worst = cpu
-            .positions()
-            .iter()
-            .zip(gpu.host().positions())
-            .map(|(p, q)| (*p - *q).length())
-            .fold(0.0, f32::max);
+        let worst = worst_gap(cpu.positions(), gpu.host().positions());
         assert!(
             worst < 1e-4 * size,
             "frame {frame}: positions differ by {worst:e} m (mesh size {size} m)"
@@ -104,12 +107,7 @@ fn gpu_matches_cpu_on_a_scalpel_incision() {
         gpu.move_tool(pose);
         let a = cpu.step_frame().unwrap();
         let b = gpu.step_frame().unwrap();
-        let worst = cpu
-            .positions()
-            .iter()
-            .zip(gpu.host().positions())
-            .map(|(p, q)| (*p - *q).length())
-            .fold(0.0, f32::max);
+        let worst = worst_gap(cpu.positions(), gpu.host().positions());
         assert!(
             worst < 1e-4 * size,
             "frame {frame}: positions differ by {worst:e} m"

@@ -105,6 +105,8 @@ pub struct RenderSettings {
     pub tool: ToolState,
     /// Background colour (linear RGB).
     pub background: [f64; 3],
+    /// Background alpha: 1 opaque; 0 lets a layer behind show through (XR passthrough).
+    pub background_alpha: f64,
     /// Exposure applied before tone mapping.
     pub exposure: f32,
 }
@@ -117,6 +119,7 @@ impl Default for RenderSettings {
             stress_max: 1e4,
             tool: ToolState::default(),
             background: [0.020, 0.024, 0.032],
+            background_alpha: 1.0,
             exposure: 1.0,
         }
     }

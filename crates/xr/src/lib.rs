@@ -16,6 +16,7 @@ pub mod frame;
 mod gpu_skin;
 pub mod image_io;
 pub mod offscreen;
+pub mod openxr;
 mod pipelines;
 pub mod renderer;
 mod scene_buffers;

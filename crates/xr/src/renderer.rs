@@ -237,7 +237,12 @@ impl Renderer {
             wgpu::Color::BLACK
         } else {
             let [r, g, b] = s.background;
-            wgpu::Color { r, g, b, a: 1.0 }
+            wgpu::Color {
+                r,
+                g,
+                b,
+                a: s.background_alpha,
+            }
         };
         let last = views.len().saturating_sub(1);
         for (i, (_, target)) in views.iter().enumerate() {

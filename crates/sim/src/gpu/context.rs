@@ -46,6 +46,40 @@ pub struct GpuContext {
     pub timestamps: bool,
     /// Largest storage buffer binding, bytes.
     pub max_binding: u64,
+    /// The first device loss or uncaptured device error, if one happened.
+    pub fault: DeviceFault,
+}
+
+/// Where a device reports that it was lost or hit an error nobody captured (instead of
+/// wgpu's default, a panic): the solver checks it every frame and stops with
+/// `SolverError::Device`, which the app answers by going on with the CPU solver.
+#[derive(Debug, Clone, Default)]
+pub struct DeviceFault(std::sync::Arc<std::sync::Mutex<Option<String>>>);
+
+impl DeviceFault {
+    /// Record `msg` unless a fault is already recorded.
+    pub fn record(&self, msg: String) {
+        if let Ok(mut slot) = self.0.lock() {
+            slot.get_or_insert(msg);
+        }
+    }
+
+    /// The recorded fault, if any.
+    pub fn get(&self) -> Option<String> {
+        self.0.lock().ok().and_then(|s| s.clone())
+    }
+
+    /// Route `device`'s loss and uncaptured errors here.
+    pub fn watch(&self, device: &wgpu::Device) {
+        let lost = self.clone();
+        device.set_device_lost_callback(move |reason, msg| {
+            lost.record(format!("device lost ({reason:?}): {msg}"));
+        });
+        let errors = self.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            errors.record(format!("device error: {e}"));
+        }));
+    }
 }
 
 impl GpuContext {
@@ -105,7 +139,10 @@ impl GpuContext {
                 adapter: info.name.clone(),
                 msg: e.to_string(),
             })?;
+        let fault = DeviceFault::default();
+        fault.watch(&device);
         Ok(GpuContext {
+            fault,
             device,
             queue,
             max_binding: available.max_storage_buffer_binding_size as u64,

@@ -8,6 +8,6 @@ mod kernels;
 mod layout;
 mod solver;
 
-pub use context::{GpuContext, GpuError};
+pub use context::{DeviceFault, GpuContext, GpuError};
 pub use kernels::{SHADER_STAGES, shader_source};
 pub use solver::{GpuSolver, GpuTiming};

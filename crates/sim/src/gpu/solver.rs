@@ -99,6 +99,7 @@ pub struct GpuSolver {
     offsets: Vec<[f32; 4]>,
     params: Params,
     tool_words: Vec<[f32; 4]>,
+    fault: super::context::DeviceFault,
 }
 
 fn storage(
@@ -415,7 +416,39 @@ impl GpuSolver {
             last_timing: None,
             params,
             tool_words: Vec::new(),
+            fault: ctx.fault.clone(),
         })
+    }
+
+    /// Give back the host mirror: the solver state as of the last completed frame (to go
+    /// on with the CPU solver after a device failure).
+    pub fn into_host(self) -> Solver {
+        self.host
+    }
+
+    /// Fault injection for tests: destroy the device, as a driver reset or an unplugged
+    /// GPU would; the next frame fails with `SolverError::Device`.
+    pub fn inject_device_loss(&self) {
+        self.device.destroy();
+    }
+
+    /// Fault injection for tests: a NaN velocity for `node` on the device (see
+    /// [`Solver::inject_non_finite`]).
+    pub fn inject_non_finite(&self, node: usize) {
+        if node < self.host.x.len() {
+            self.queue.write_buffer(
+                &self.buf.vel,
+                node as u64 * 16,
+                bytemuck::bytes_of(&[f32::NAN; 4]),
+            );
+        }
+    }
+
+    fn check_device(&self) -> Result<(), SolverError> {
+        match self.fault.get() {
+            Some(msg) => Err(SolverError::Device(msg)),
+            None => Ok(()),
+        }
     }
 
     /// Attach a tool at `pose` (see [`Solver::set_tool`]).
@@ -465,6 +498,7 @@ impl GpuSolver {
     /// cut state. On a guard failure the frame is rolled back on both sides.
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
         let t0 = Instant::now();
+        self.check_device()?;
         self.upload_grab_offsets();
         self.upload_tool();
         let mut enc = self
@@ -503,9 +537,24 @@ impl GpuSolver {
             enc.copy_buffer_to_buffer(&ts.resolve, 0, &ts.read, 0, 16);
         }
         self.queue.submit([enc.finish()]);
-        let released = self
+        // The last good state, kept until the device has said the frame went well (a lost
+        // device can map buffers of zeros).
+        let good = (self.host.u.clone(), self.host.v.clone());
+        let read = self
             .read_back()
-            .map_err(|e| SolverError::Device(e.to_string()))?;
+            .map_err(|e| SolverError::Device(e.to_string()));
+        let released = match (read, self.fault.get()) {
+            (Ok(r), None) => r,
+            (read, fault) => {
+                (self.host.u, self.host.v) = good;
+                self.host.sync_positions();
+                return Err(match (fault, read) {
+                    (Some(msg), _) => SolverError::Device(msg),
+                    (None, Err(e)) => e,
+                    (None, Ok(_)) => unreachable!("handled above"),
+                });
+            }
+        };
         // Device work ends when the readback completes: that is the frame's solve time.
         let t1 = Instant::now();
         let solve_ms = (t1 - t0).as_secs_f64() * 1e3;

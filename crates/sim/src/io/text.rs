@@ -266,11 +266,13 @@ impl<'a> Fields<'a> {
 }
 
 /// Room to reserve for `count` items announced by a header, bounded by what `text` can hold
-/// so that a bogus count cannot exhaust memory.
+/// so that a bogus count cannot exhaust memory: a node, element or vertex line takes at
+/// least 8 bytes (`"1 0 0 0\n"`), so a file of n bytes holds at most n/8 + 1 of them.
+/// (A reservation is only a hint: more items still fit, the vector grows.)
 pub fn capacity(count: u64, text: &str) -> usize {
     usize::try_from(count)
         .unwrap_or(usize::MAX)
-        .min(text.len() / 2 + 1)
+        .min(text.len() / 8 + 1)
 }
 
 #[cfg(test)]
@@ -362,7 +364,8 @@ mod tests {
 
     #[test]
     fn capacity_is_bounded_by_text() {
-        assert_eq!(capacity(u64::MAX, "abcd"), 3);
+        assert_eq!(capacity(u64::MAX, "abcd"), 1);
+        assert_eq!(capacity(u64::MAX, &"x".repeat(800)), 101);
         assert_eq!(capacity(1, "abcd"), 1);
     }
 }

@@ -84,6 +84,13 @@ impl TetMesh {
         }
 
         let (node_tet_offsets, node_tet_list) = node_tet_csr(n, &tets);
+        let mut warnings = warnings;
+        let unreferenced = node_tet_offsets.windows(2).filter(|w| w[0] == w[1]).count();
+        if unreferenced > 0 {
+            warnings.push(format!(
+                "{unreferenced} unreferenced node(s) in no tet: kept for indexing, not simulated"
+            ));
+        }
         let face_neighbors = face_neighbors(&tets);
         let boundary = face_neighbors
             .iter()

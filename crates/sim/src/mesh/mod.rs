@@ -2,12 +2,14 @@
 //! (PHYSICS.md §1.1), adjacency and boundary faces.
 
 mod build;
+mod closest_point;
 mod edges;
 pub mod quality;
 mod surface;
 pub mod topology;
 
 pub use build::{DEGENERATE_REL, MeshBuildReport};
+pub use closest_point::closest_point_on_triangle;
 pub use edges::EdgeList;
 pub use surface::TriSurface;
 

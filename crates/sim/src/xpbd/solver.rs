@@ -169,6 +169,12 @@ impl Solver {
             params,
             mesh,
         };
+        // Nodes in no tet have no mass: they are not simulated (PHYSICS.md §1.1 masses).
+        for (k, m) in solver.kind.iter_mut().zip(&solver.mass) {
+            if *m <= 0.0 {
+                *k = NodeKind::Retired;
+            }
+        }
         solver.slots = order
             .iter()
             .map(|&t| TetSlot {
@@ -324,6 +330,14 @@ impl Solver {
     /// Nodes that came within the cut reach of a cutting sphere during the last frame.
     pub fn near_edge(&self) -> &[bool] {
         &self.near_edge
+    }
+
+    /// Fault injection for tests: give free node `node` a NaN velocity, as a solver bug
+    /// would; the next frame must stop with `SolverError::NonFinite` and roll back.
+    pub fn inject_non_finite(&mut self, node: usize) {
+        if let Some(v) = self.v.get_mut(node) {
+            *v = Vec3::NAN;
+        }
     }
 
     /// Release tets by hand (mesh indices); returns what changed.

@@ -1,0 +1,74 @@
+//! Why the XR mode could not start or went down.
+
+use super::lifecycle::FrameOrderError;
+use crate::error::RenderError;
+
+/// An XR failure. The first four mean "no usable OpenXR runtime here" (the app exits 2
+/// with advice); the rest are failures of a runtime that was found.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum XrError {
+    /// The OpenXR loader library could not be opened.
+    #[error("the OpenXR loader (libopenxr_loader) could not be opened: {0}")]
+    LoaderMissing(String),
+    /// The loader found no active runtime.
+    #[error("the OpenXR loader found no active runtime ({0})")]
+    RuntimeUnavailable(String),
+    /// The runtime cannot render with Vulkan (`XR_KHR_vulkan_enable2` missing).
+    #[error("the OpenXR runtime {runtime} does not offer XR_KHR_vulkan_enable2 (Vulkan rendering)")]
+    NoVulkan {
+        /// Runtime name and version.
+        runtime: String,
+    },
+    /// The runtime has no headset connected.
+    #[error("the OpenXR runtime {runtime} reports no headset ({detail})")]
+    NoHeadset {
+        /// Runtime name and version.
+        runtime: String,
+        /// The runtime's answer.
+        detail: String,
+    },
+    /// An OpenXR call failed.
+    #[error("{call} failed: {result}")]
+    Xr {
+        /// The call.
+        call: &'static str,
+        /// The runtime's result code.
+        result: ::openxr::sys::Result,
+    },
+    /// A Vulkan call made through the runtime failed.
+    #[error("{call} failed: Vulkan error {code}")]
+    Vulkan {
+        /// The call.
+        call: &'static str,
+        /// `VkResult`.
+        code: i32,
+    },
+    /// Opening wgpu on the runtime's Vulkan device failed.
+    #[error("wrapping the runtime's Vulkan device into wgpu failed: {0}")]
+    Gpu(String),
+    /// Rendering failed.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The frame loop called the runtime out of order.
+    #[error(transparent)]
+    FrameOrder(#[from] FrameOrderError),
+}
+
+impl XrError {
+    /// Whether this means no usable runtime or headset (as opposed to a failure of one).
+    pub fn is_unavailable(&self) -> bool {
+        matches!(
+            self,
+            XrError::LoaderMissing(_)
+                | XrError::RuntimeUnavailable(_)
+                | XrError::NoVulkan { .. }
+                | XrError::NoHeadset { .. }
+        )
+    }
+}
+
+/// `map_err` helper: name the OpenXR call that failed.
+pub(crate) fn xr_call(call: &'static str) -> impl Fn(::openxr::sys::Result) -> XrError {
+    move |result| XrError::Xr { call, result }
+}

@@ -1,0 +1,51 @@
+//! Controller vibration per frame. The force → amplitude curve belongs to the scalpel
+//! (incise-scalpel's `HapticCurve`); the app passes the amplitude in, and this turns it
+//! into the pulse sent with `xrApplyHapticFeedback`.
+
+/// Amplitudes below this are not sent (the Quest motors do not render them).
+pub const MIN_AMPLITUDE: f32 = 0.02;
+/// Vibration frequency requested, Hz (0 lets the runtime choose; Quest Touch: ~160 Hz).
+pub const FREQUENCY_HZ: f32 = 0.0;
+
+/// One vibration pulse (OpenXR `XrHapticVibration`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HapticPulse {
+    /// Amplitude, 0..1.
+    pub amplitude: f32,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Frequency, Hz (0: the runtime's optimum).
+    pub frequency_hz: f32,
+}
+
+/// The pulse for this frame: amplitude `amplitude` (0..1, NaN as 0) while the blade is
+/// engaged, lasting one display period plus half (so consecutive frames overlap and the
+/// motor does not stutter); `None` to stop the vibration.
+pub fn haptic_pulse(amplitude: f32, engaged: bool, display_period_s: f64) -> Option<HapticPulse> {
+    let a = if amplitude.is_nan() {
+        0.0
+    } else {
+        amplitude.clamp(0.0, 1.0)
+    };
+    (engaged && a >= MIN_AMPLITUDE).then_some(HapticPulse {
+        amplitude: a,
+        duration_s: display_period_s * 1.5,
+        frequency_hz: FREQUENCY_HZ,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn amplitude_passes_through_clamped_only_while_engaged() {
+        let p = haptic_pulse(0.5, true, 1.0 / 72.0).unwrap();
+        assert_eq!(p.amplitude, 0.5);
+        assert!((p.duration_s - 1.5 / 72.0).abs() < 1e-12);
+        assert_eq!(haptic_pulse(1.7, true, 0.01).unwrap().amplitude, 1.0);
+        assert!(haptic_pulse(0.5, false, 0.01).is_none());
+        assert!(haptic_pulse(0.01, true, 0.01).is_none());
+        assert!(haptic_pulse(f32::NAN, true, 0.01).is_none());
+    }
+}

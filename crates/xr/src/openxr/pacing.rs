@@ -1,0 +1,231 @@
+//! Frame pacing: the simulation advances on its own fixed frame dt, decoupled from the
+//! display rate (72/90/120 Hz), inside a time budget per display frame. When a display
+//! frame runs late, substeps are reduced first (down to the stable minimum); only when
+//! even those do not fit is simulated time given up (the tissue runs slower than real
+//! time) — the display never waits for the simulation.
+
+/// What the pacer needs to know of the simulation and the display.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PacingConfig {
+    /// Simulation frame length, s (the scene's `frame_dt`).
+    pub sim_dt: f64,
+    /// The scene's substeps per simulation frame.
+    pub nominal_substeps: u32,
+    /// The fewest substeps that stay stable for the material and mesh.
+    pub min_substeps: u32,
+    /// Fraction of a display period the simulation may use (the rest renders).
+    pub budget_fraction: f64,
+    /// Most simulation frames per display frame (catching up after a stall).
+    pub max_sim_frames: u32,
+}
+
+/// The work for one display frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FramePlan {
+    /// Simulation frames to step now.
+    pub sim_frames: u32,
+    /// Substeps per simulation frame.
+    pub substeps: u32,
+}
+
+/// The pacer: accumulates display time and plans simulation frames against the measured
+/// cost of a substep.
+#[derive(Debug, Clone)]
+pub struct FramePacer {
+    cfg: PacingConfig,
+    accumulator: f64,
+    substeps: u32,
+    last_display_time: Option<f64>,
+    /// Smoothed wall time of one substep, s (None until measured).
+    substep_cost: Option<f64>,
+    dropped: f64,
+}
+
+impl FramePacer {
+    /// A pacer starting at the nominal substeps.
+    pub fn new(cfg: PacingConfig) -> Self {
+        let min = cfg.min_substeps.clamp(1, cfg.nominal_substeps.max(1));
+        FramePacer {
+            cfg: PacingConfig {
+                min_substeps: min,
+                nominal_substeps: cfg.nominal_substeps.max(min),
+                max_sim_frames: cfg.max_sim_frames.max(1),
+                ..cfg
+            },
+            accumulator: 0.0,
+            substeps: cfg.nominal_substeps.max(min),
+            last_display_time: None,
+            substep_cost: None,
+            dropped: 0.0,
+        }
+    }
+
+    /// The configuration in use (limits applied).
+    pub fn config(&self) -> &PacingConfig {
+        &self.cfg
+    }
+
+    /// Simulated time given up so far, s.
+    pub fn dropped_time(&self) -> f64 {
+        self.dropped
+    }
+
+    /// Report the wall time `sim_wall_s` the last plan's `plan.sim_frames × plan.substeps`
+    /// substeps took (exponentially smoothed, so one hiccup does not halve the substeps).
+    pub fn record(&mut self, plan: FramePlan, sim_wall_s: f64) {
+        let n = plan.sim_frames as f64 * plan.substeps as f64;
+        if n <= 0.0 || !sim_wall_s.is_finite() || sim_wall_s < 0.0 {
+            return;
+        }
+        let c = sim_wall_s / n;
+        self.substep_cost = Some(match self.substep_cost {
+            None => c,
+            Some(old) => 0.5 * old + 0.5 * c,
+        });
+    }
+
+    /// The plan for the display frame shown at `display_time` (s, the runtime's predicted
+    /// display time), `display_period` s after the previous one.
+    pub fn plan(&mut self, display_time: f64, display_period: f64) -> FramePlan {
+        let elapsed = match self.last_display_time {
+            Some(t) if display_time > t => display_time - t,
+            Some(_) => 0.0,
+            None => display_period,
+        };
+        self.last_display_time = Some(display_time);
+        self.accumulator += elapsed;
+        let dt = self.cfg.sim_dt;
+        let mut frames = ((self.accumulator + 1e-9) / dt).floor() as u32;
+        if frames > self.cfg.max_sim_frames {
+            let extra = (frames - self.cfg.max_sim_frames) as f64 * dt;
+            self.dropped += extra;
+            self.accumulator -= extra;
+            frames = self.cfg.max_sim_frames;
+        }
+        let budget = self.cfg.budget_fraction * display_period;
+        let substeps = match self.substep_cost {
+            Some(c) if frames > 0 && c > 0.0 => {
+                let affordable = (budget / (c * frames as f64)).floor() as u32;
+                // Recover gently (a quarter more per frame), cut at once.
+                let grown = self.substeps + (self.substeps / 4).max(1);
+                affordable.min(grown).min(self.cfg.nominal_substeps)
+            }
+            _ => self.substeps,
+        }
+        .max(self.cfg.min_substeps);
+        // Even the fewest substeps do not fit: simulate fewer frames, give up that time.
+        if let Some(c) = self.substep_cost {
+            while frames > 1 && c * (frames * substeps) as f64 > budget {
+                frames -= 1;
+                self.dropped += dt;
+                self.accumulator -= dt;
+            }
+        }
+        self.accumulator -= frames as f64 * dt;
+        self.substeps = substeps;
+        FramePlan {
+            sim_frames: frames,
+            substeps,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cfg() -> PacingConfig {
+        PacingConfig {
+            sim_dt: 1.0 / 60.0,
+            nominal_substeps: 20,
+            min_substeps: 8,
+            budget_fraction: 0.5,
+            max_sim_frames: 3,
+        }
+    }
+
+    #[test]
+    fn the_simulation_keeps_its_own_rate_under_a_faster_display() {
+        // 72 Hz display, 60 Hz simulation: over one second, 60 simulation frames in 72
+        // display frames, some display frames with none.
+        let mut p = FramePacer::new(cfg());
+        let period = 1.0 / 72.0;
+        let plans: Vec<FramePlan> = (1..=72)
+            .map(|i| p.plan(i as f64 * period, period))
+            .collect();
+        let total: u32 = plans.iter().map(|p| p.sim_frames).sum();
+        assert!((59..=60).contains(&total), "{total}");
+        assert_eq!(
+            plans.iter().filter(|p| p.sim_frames == 0).count() as u32,
+            72 - total
+        );
+        assert!(plans.iter().all(|p| p.substeps == 20));
+        assert_eq!(p.dropped_time(), 0.0);
+    }
+
+    #[test]
+    fn a_late_frame_reduces_substeps_before_giving_up_time() {
+        let mut p = FramePacer::new(cfg());
+        let period = 1.0 / 60.0;
+        let first = p.plan(period, period);
+        assert_eq!(
+            first,
+            FramePlan {
+                sim_frames: 1,
+                substeps: 20
+            }
+        );
+        // Budget 8.33 ms; 20 substeps took 16 ms: 0.8 ms each → 10 substeps fit.
+        p.record(first, 20.0 * 0.0008);
+        let second = p.plan(2.0 * period, period);
+        assert_eq!(
+            second,
+            FramePlan {
+                sim_frames: 1,
+                substeps: 10
+            }
+        );
+        assert_eq!(p.dropped_time(), 0.0);
+        // Much slower (2 ms a substep, smoothed to 1.4 ms): 5 would fit, the floor is 8 —
+        // one simulation frame is still stepped (never zero while time is owed).
+        p.record(second, 10.0 * 0.002);
+        let third = p.plan(3.0 * period, period);
+        assert_eq!(
+            third,
+            FramePlan {
+                sim_frames: 1,
+                substeps: 8
+            }
+        );
+        // A display stall of 4 periods: at most 3 frames are owed, the rest is given up,
+        // and of those only as many as fit at 8 substeps are stepped.
+        p.record(third, 8.0 * 0.0001);
+        let stalled = p.plan(7.0 * period, period);
+        assert!(stalled.sim_frames <= 3 && stalled.sim_frames >= 1);
+        assert!(p.dropped_time() >= period - 1e-9, "{}", p.dropped_time());
+    }
+
+    #[test]
+    fn substeps_recover_gradually_once_frames_are_cheap_again() {
+        let mut p = FramePacer::new(cfg());
+        let period = 1.0 / 60.0;
+        let plan = p.plan(period, period);
+        p.record(plan, 20.0 * 0.002); // very late: down to the floor
+        let low = p.plan(2.0 * period, period);
+        assert_eq!(low.substeps, 8);
+        let mut t = 2.0;
+        let mut last = low;
+        let mut seen = vec![low.substeps];
+        for _ in 0..20 {
+            p.record(last, last.substeps as f64 * 1e-6);
+            t += 1.0;
+            last = p.plan(t * period, period);
+            seen.push(last.substeps);
+        }
+        // Back to nominal, never above it, at most a quarter more per frame.
+        assert_eq!(*seen.last().unwrap(), 20, "{seen:?}");
+        for w in seen.windows(2) {
+            assert!(w[1] >= w[0] && w[1] - w[0] <= (w[0] / 4).max(1), "{seen:?}");
+        }
+    }
+}

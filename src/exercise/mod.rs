@@ -1,0 +1,25 @@
+//! Training exercises (issue 10): a task on a scene (a planned incision with a target
+//! depth and tolerance band, a time limit, pass thresholds), objective metrics of an
+//! attempt computed from the simulation state, a score, a one-page HTML report and a
+//! local history of attempts. Definitions: docs/scoring.md.
+
+mod attempt;
+mod history;
+mod load;
+mod metrics;
+mod model;
+mod plan;
+mod reference;
+mod report_html;
+mod score;
+
+pub use attempt::{Attempt, ExerciseOptions, ExerciseResult, run_exercise};
+pub use history::{
+    HistoryEntry, append as append_history, read as read_history, table as history_table,
+};
+pub use load::{LoadedExercise, load_exercise, parse_exercise};
+pub use metrics::{Metrics, STROKE_GAP_FRAMES, compute as compute_metrics};
+pub use model::{Exercise, PassThresholds, Tolerance};
+pub use plan::{Plan, PlanCoords, PlanSample, RestSurface};
+pub use reference::{ReferenceStyle, reference_stroke, write_reference_stroke};
+pub use score::{Check, Verdict, WEIGHTS, Weights, judge};

@@ -1,0 +1,112 @@
+//! The frame-time log of an XR session: one row per display frame, written as CSV for
+//! plotting and for comparing a headset run with a simulated one.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+/// One display frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FrameRow {
+    /// Display frame index.
+    pub frame: u64,
+    /// Predicted display time, s (from the session's start).
+    pub display_time: f64,
+    /// Simulation frames stepped.
+    pub sim_frames: u32,
+    /// Substeps per simulation frame.
+    pub substeps: u32,
+    /// Wall time of the simulation, ms.
+    pub sim_ms: f64,
+    /// Wall time of recording the frame's rendering (prepare, draw, submit), ms.
+    pub render_ms: f64,
+    /// Wall time of the whole frame, from `next_frame` returning to the frame ending, ms.
+    pub frame_ms: f64,
+    /// Whether the eyes were rendered.
+    pub rendered: bool,
+    /// Blade engaged (trigger).
+    pub engaged: bool,
+    /// Tool contact force, N.
+    pub tool_force: f32,
+    /// Vibration amplitude sent, 0..1.
+    pub haptic: f32,
+}
+
+/// The rows of a session.
+#[derive(Debug, Clone, Default)]
+pub struct FrameLog {
+    /// Rows in frame order.
+    pub rows: Vec<FrameRow>,
+}
+
+impl FrameLog {
+    /// The log as CSV with a header line.
+    pub fn to_csv(&self) -> String {
+        let mut s = String::from(
+            "frame,display_time_s,sim_frames,substeps,sim_ms,render_ms,frame_ms,rendered,engaged,tool_force_n,haptic\n",
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                s,
+                "{},{:.6},{},{},{:.3},{:.3},{:.3},{},{},{:.4},{:.3}",
+                r.frame,
+                r.display_time,
+                r.sim_frames,
+                r.substeps,
+                r.sim_ms,
+                r.render_ms,
+                r.frame_ms,
+                u8::from(r.rendered),
+                u8::from(r.engaged),
+                r.tool_force,
+                r.haptic
+            );
+        }
+        s
+    }
+
+    /// Write the CSV to `path`.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        std::fs::write(path, self.to_csv()).with_context(|| format!("writing {}", path.display()))
+    }
+
+    /// The `q`-quantile (0..1) of frame wall times, ms, over rendered frames.
+    pub fn frame_ms_quantile(&self, q: f64) -> Option<f64> {
+        let mut v: Vec<f64> = self
+            .rows
+            .iter()
+            .filter(|r| r.rendered)
+            .map(|r| r.frame_ms)
+            .collect();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f64::total_cmp);
+        let i = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+        Some(v[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_has_a_header_and_a_line_per_frame() {
+        let mut log = FrameLog::default();
+        for i in 0..3 {
+            log.rows.push(FrameRow {
+                frame: i,
+                rendered: true,
+                frame_ms: 10.0 * (i + 1) as f64,
+                ..Default::default()
+            });
+        }
+        let csv = log.to_csv();
+        assert_eq!(csv.lines().count(), 4);
+        assert!(csv.starts_with("frame,display_time_s"));
+        assert_eq!(log.frame_ms_quantile(0.5), Some(20.0));
+        assert_eq!(log.frame_ms_quantile(1.0), Some(30.0));
+    }
+}

@@ -1,0 +1,275 @@
+//! The XR frame loop, the same for the OpenXR session and the simulated headset: per
+//! display frame, controller input → tray and scalpel, the pacer's simulation frames
+//! (fixed dt, substeps cut before time when late), vibration from the contact force, both
+//! eyes rendered into the headset's targets, and a frame-time row.
+
+use std::time::Instant;
+
+use anyhow::Result;
+use glam::Mat4;
+use incise_scalpel::{Stroke, StrokeRecorder};
+use incise_sim::skin::Skin;
+use incise_xr::frame::{ToolState, pinned_nodes};
+use incise_xr::openxr::controls::{ControllerState, commands};
+use incise_xr::openxr::eye::eye_view;
+use incise_xr::openxr::haptics::haptic_pulse;
+use incise_xr::openxr::lifecycle::ExitReason;
+use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
+use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
+use incise_xr::openxr::tray::Tray;
+use incise_xr::openxr::{FrameEvent, Headset};
+use incise_xr::{BodyState, RenderSettings, Renderer};
+
+use super::frame_log::{FrameLog, FrameRow};
+use super::xr_body::XrBody;
+use crate::screenshots::stress_scale;
+
+/// Fraction of a display period the simulation may use.
+pub const SIM_BUDGET: f64 = 0.5;
+/// Most simulation frames stepped in one display frame.
+pub const MAX_SIM_FRAMES: u32 = 3;
+/// `Idle` answers in a row after which the loop gives up (about 10 s of a runtime that
+/// never makes the session ready).
+const MAX_IDLE: u32 = 1000;
+
+/// How the loop runs.
+pub struct LoopOptions<'a> {
+    /// Stop after this many display frames (asks the session to exit).
+    pub max_frames: Option<u64>,
+    /// Where the blade sits on the right controller.
+    pub blade: BladeOffset,
+    /// Contact force (N) → vibration amplitude (0..1): the scalpel's haptic curve.
+    pub haptic: &'a dyn Fn(f32) -> f32,
+    /// Keep the scene's substeps whatever the measured cost.
+    pub nominal_pacing: bool,
+    /// Record the scalpel's path as a stroke.
+    pub record: bool,
+    /// The tray at the start.
+    pub tray: Tray,
+}
+
+/// What a session did.
+pub struct LoopOutcome {
+    /// Display frames run.
+    pub frames: u64,
+    /// Display frames rendered.
+    pub rendered: u64,
+    /// Simulation frames stepped.
+    pub sim_frames: u64,
+    /// Released tets at the end.
+    pub released_tets: usize,
+    /// Largest tool contact force, N.
+    pub max_tool_force: f32,
+    /// Largest vibration amplitude sent.
+    pub max_haptic: f32,
+    /// Simulated time given up to keep the display on time, s.
+    pub dropped_time: f64,
+    /// Fewest substeps used.
+    pub min_substeps_used: u32,
+    /// Times the solver failed and the scene was reset.
+    pub solver_resets: u32,
+    /// How the session ended (`None`: the runtime never made it ready).
+    pub exit: Option<ExitReason>,
+    /// The scalpel's path, when recorded and the controller was tracked.
+    pub stroke: Option<Stroke>,
+    /// Per-frame times.
+    pub log: FrameLog,
+}
+
+/// Run the session on `headset` until it ends.
+pub fn run_loop(
+    headset: &mut dyn Headset,
+    xr: &mut XrBody,
+    skin: &Skin,
+    opts: &LoopOptions<'_>,
+) -> Result<LoopOutcome> {
+    let dev = headset.device().clone();
+    let mut renderer = Renderer::new(
+        &dev.device,
+        &dev.queue,
+        headset.format(),
+        xr.solver().mesh(),
+        skin,
+    );
+    let nominal = xr.nominal_substeps();
+    let sim_dt = xr.solver().params().frame_dt as f64;
+    let mut pacer = FramePacer::new(PacingConfig {
+        sim_dt,
+        nominal_substeps: nominal,
+        min_substeps: if opts.nominal_pacing {
+            nominal
+        } else {
+            xr.min_substeps()
+        },
+        budget_fraction: SIM_BUDGET,
+        max_sim_frames: MAX_SIM_FRAMES,
+    });
+    let mut tray = opts.tray;
+    let mut previous = ControllerState::default();
+    let (mut paused, mut stress) = (false, false);
+    let mut recorder = StrokeRecorder::new();
+    let mut sim_time = 0.0f64;
+    let mut out = LoopOutcome {
+        frames: 0,
+        rendered: 0,
+        sim_frames: 0,
+        released_tets: 0,
+        max_tool_force: 0.0,
+        max_haptic: 0.0,
+        dropped_time: 0.0,
+        min_substeps_used: nominal,
+        solver_resets: 0,
+        exit: None,
+        stroke: None,
+        log: FrameLog::default(),
+    };
+    let (background, background_alpha) = headset.backdrop().clear();
+    let mut idle = 0;
+    let mut exit_asked = false;
+    loop {
+        let frame = match headset.next_frame()? {
+            FrameEvent::Ended(why) => {
+                out.exit = Some(why);
+                break;
+            }
+            FrameEvent::Idle => {
+                idle += 1;
+                if idle > MAX_IDLE {
+                    break;
+                }
+                continue;
+            }
+            FrameEvent::Frame(f) => *f,
+        };
+        idle = 0;
+        let started = Instant::now();
+        let c = frame.controllers;
+        let cmd = commands(&previous, &c);
+        previous = c;
+        if cmd.reset {
+            xr.reset()?;
+        }
+        stress ^= cmd.toggle_stress;
+        paused ^= cmd.toggle_pause;
+        if let (true, Some(grip)) = (c.moving_tray(), c.left_grip) {
+            tray = tray.placed_at(grip);
+        }
+        tray = tray.steered(c.stick, frame.display_period as f32);
+        let engaged = c.blade_engaged();
+        let tool_pose = c.right_grip.map(|g| scalpel_pose(g, opts.blade, &tray));
+
+        // Simulation: the pacer's frames at the fixed dt, never waiting for the display.
+        let mut plan = pacer.plan(frame.display_time, frame.display_period);
+        if paused {
+            plan.sim_frames = 0;
+        }
+        if plan.substeps != xr.solver().params().substeps {
+            xr.set_substeps(plan.substeps)?;
+        }
+        let sim_start = Instant::now();
+        let mut force = 0.0f32;
+        for _ in 0..plan.sim_frames {
+            xr.drive_tool(tool_pose, engaged)?;
+            let stats = match xr.step() {
+                Ok(s) => s,
+                Err(e) => {
+                    // The solver gave up (a tet inverted too long): the frame is rolled
+                    // back; start the scene again rather than end the trainee's session.
+                    eprintln!("xr: {e:#}; resetting the scene");
+                    out.solver_resets += 1;
+                    xr.reset()?;
+                    break;
+                }
+            };
+            sim_time += sim_dt;
+            force = force.max(stats.tool_force.length());
+            if let (true, Some(p)) = (opts.record, tool_pose) {
+                recorder.push(sim_time, p)?;
+            }
+        }
+        let sim_ms = sim_start.elapsed().as_secs_f64() * 1e3;
+        if plan.sim_frames > 0 {
+            pacer.record(plan, sim_ms * 1e-3);
+            out.min_substeps_used = out.min_substeps_used.min(plan.substeps);
+        }
+        out.sim_frames += plan.sim_frames as u64;
+        out.max_tool_force = out.max_tool_force.max(force);
+
+        let amplitude = (opts.haptic)(force);
+        let pulse = haptic_pulse(amplitude, engaged, frame.display_period);
+        headset.vibrate(pulse)?;
+        let sent = pulse.map_or(0.0, |p| p.amplitude);
+        out.max_haptic = out.max_haptic.max(sent);
+
+        // Both eyes into the headset's targets.
+        let render_start = Instant::now();
+        if frame.should_render {
+            let targets = headset.acquire()?;
+            let stage_from_sim = tray.stage_from_sim();
+            let views = frame
+                .eyes
+                .map(|(pose, fov)| eye_view(pose, fov, stage_from_sim));
+            let solver = xr.solver();
+            let pinned = pinned_nodes(solver);
+            let (pose, tracked) = xr.tool();
+            let settings = RenderSettings {
+                stress_max: stress_scale(solver),
+                tool: ToolState {
+                    transform: tracked
+                        .then(|| Mat4::from_rotation_translation(pose.rotation, pose.position)),
+                    spheres: vec![],
+                },
+                overlays: incise_xr::Overlays {
+                    stress,
+                    ..Default::default()
+                },
+                background,
+                background_alpha,
+                ..RenderSettings::default()
+            };
+            let mut enc = dev
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("xr frame"),
+                });
+            renderer.prepare(&mut enc, &BodyState::of_solver(solver, &pinned), &settings);
+            renderer.render(
+                &mut enc,
+                &[(views[0], &targets[0]), (views[1], &targets[1])],
+                headset.eye_size(),
+            );
+            dev.queue.submit([enc.finish()]);
+            headset.end_frame(true)?;
+            out.rendered += 1;
+        } else {
+            headset.end_frame(false)?;
+        }
+        out.log.rows.push(FrameRow {
+            frame: out.frames,
+            display_time: frame.display_time,
+            sim_frames: plan.sim_frames,
+            substeps: plan.substeps,
+            sim_ms,
+            render_ms: render_start.elapsed().as_secs_f64() * 1e3,
+            frame_ms: started.elapsed().as_secs_f64() * 1e3,
+            rendered: frame.should_render,
+            engaged,
+            tool_force: force,
+            haptic: sent,
+        });
+        out.frames += 1;
+        if !exit_asked && opts.max_frames.is_some_and(|m| out.frames >= m) {
+            exit_asked = true;
+            headset.request_exit()?;
+        }
+    }
+    headset.vibrate(None)?;
+    out.dropped_time = pacer.dropped_time();
+    out.released_tets = (0..xr.solver().mesh().tet_count())
+        .filter(|&i| !xr.solver().cut().is_live(i))
+        .count();
+    if opts.record && !recorder.is_empty() {
+        out.stroke = Some(recorder.finish()?);
+    }
+    Ok(out)
+}

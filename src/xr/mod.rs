@@ -1,0 +1,212 @@
+//! `incise xr [SCENE]`: the scene on a tray in the room, cut with the right controller
+//! (issue 7). With `--simulated-headset SCRIPT.ron` the same frame loop runs without a
+//! runtime on a scripted headset, rendering both eyes offscreen.
+
+pub mod frame_log;
+pub mod frame_loop;
+pub mod script;
+pub mod simulated;
+pub mod unavailable;
+pub mod xr_body;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use incise_scalpel::HapticCurve;
+use incise_xr::RenderDevice;
+use incise_xr::openxr::scalpel_pose::BladeOffset;
+use incise_xr::openxr::tray::Tray;
+use incise_xr::openxr::{Headset, XrSession};
+use serde::Serialize;
+
+use crate::body::DeviceChoice;
+use frame_loop::{LoopOptions, LoopOutcome, run_loop};
+use script::{HeadsetScript, Pacing, RightTrack};
+use simulated::SimulatedHeadset;
+pub use unavailable::XrUnavailable;
+use xr_body::XrBody;
+
+/// What `incise xr` was asked.
+#[derive(Debug, Clone)]
+pub struct XrOptions {
+    /// Scene file.
+    pub scene: PathBuf,
+    /// Run on a simulated headset playing this script instead of a runtime.
+    pub simulated: Option<PathBuf>,
+    /// Output folder: frame log, report, eye images, recorded stroke.
+    pub out: PathBuf,
+    /// Also write the scalpel's recorded stroke here (it is always written to the
+    /// output folder as `stroke.ron`).
+    pub record_stroke: Option<PathBuf>,
+    /// Stop after this many display frames.
+    pub frames: Option<u64>,
+    /// Where the solver runs.
+    pub device: DeviceChoice,
+}
+
+/// The session summary written as `xr_report.json`.
+#[derive(Debug, Serialize)]
+pub struct XrReport {
+    /// Scene file.
+    pub scene: String,
+    /// The headset (runtime name or "simulated …") and render device.
+    pub headset: String,
+    /// Solver device.
+    pub solver_device: String,
+    /// Display frames.
+    pub frames: u64,
+    /// Frames rendered.
+    pub rendered: u64,
+    /// Simulation frames.
+    pub sim_frames: u64,
+    /// Released tets at the end.
+    pub released_tets: usize,
+    /// Largest tool force, N.
+    pub max_tool_force: f32,
+    /// Largest vibration amplitude.
+    pub max_haptic: f32,
+    /// Simulated time given up, s.
+    pub dropped_time_s: f64,
+    /// Scene substeps and the fewest used.
+    pub substeps: (u32, u32),
+    /// Median and 95th-percentile wall time of rendered frames, ms.
+    pub frame_ms_p50_p95: Option<(f64, f64)>,
+    /// Times the solver failed (an inverted tet) and the scene was reset.
+    pub solver_resets: u32,
+    /// How the session ended.
+    pub exit: String,
+    /// The recorded stroke, if any.
+    pub stroke: Option<String>,
+}
+
+/// Run `incise xr`. No usable runtime: an [`XrUnavailable`] error (exit 2).
+pub fn run(opts: &XrOptions) -> Result<XrReport> {
+    match &opts.simulated {
+        Some(script) => run_simulated(opts, script),
+        None => {
+            let mut session = XrSession::open().map_err(|e| {
+                if e.is_unavailable() {
+                    anyhow::Error::new(XrUnavailable(unavailable::message(&e, &opts.scene)))
+                } else {
+                    anyhow::Error::new(e).context("starting the OpenXR session")
+                }
+            })?;
+            eprintln!("xr: backdrop {:?}", session.backdrop());
+            let dev = session.device().clone();
+            let (mut xr, skin) = XrBody::load(&opts.scene, opts.device, &dev)?;
+            let tray = tray_for(&xr);
+            run_session(&mut session, &mut xr, &skin, opts, tray, false)
+        }
+    }
+}
+
+fn tray_for(xr: &XrBody) -> Tray {
+    let (lo, hi) = xr.solver().mesh().rest_bounds();
+    Tray::for_bounds(lo, hi)
+}
+
+fn run_simulated(opts: &XrOptions, script_path: &Path) -> Result<XrReport> {
+    let script = HeadsetScript::load(script_path)?;
+    let dev = RenderDevice::headless()?;
+    let device = match opts.device {
+        DeviceChoice::Auto => DeviceChoice::Cpu,
+        d => d,
+    };
+    let (mut xr, skin) = XrBody::load(&opts.scene, device, &dev)?;
+    let tray = tray_for(&xr);
+    let stroke = match &script.right {
+        Some(RightTrack::Tool { stroke, .. }) => Some(match stroke {
+            crate::scene::ToolStroke::File(f) => incise_scalpel::load_stroke(
+                &script_path.parent().unwrap_or(Path::new(".")).join(f),
+            )?,
+            crate::scene::ToolStroke::Incision(i) => crate::scene::incision(xr.scalpel(), i)
+                .with_context(|| format!("{}: right.stroke", script_path.display()))?,
+        }),
+        _ => None,
+    };
+    std::fs::create_dir_all(&opts.out)
+        .with_context(|| format!("creating {}", opts.out.display()))?;
+    let nominal = script.pacing == Pacing::Nominal;
+    let mut headset =
+        SimulatedHeadset::new(script, stroke, tray, BladeOffset::default(), dev, &opts.out)?;
+    run_session(&mut headset, &mut xr, &skin, opts, tray, nominal)
+}
+
+fn run_session(
+    headset: &mut dyn Headset,
+    xr: &mut XrBody,
+    skin: &incise_sim::skin::Skin,
+    opts: &XrOptions,
+    tray: Tray,
+    nominal_pacing: bool,
+) -> Result<XrReport> {
+    std::fs::create_dir_all(&opts.out)
+        .with_context(|| format!("creating {}", opts.out.display()))?;
+    let curve = HapticCurve::default();
+    let haptic = move |f: f32| curve.amplitude(f);
+    let describe = headset.describe();
+    eprintln!("xr: {describe}");
+    let outcome: LoopOutcome = run_loop(
+        headset,
+        xr,
+        skin,
+        &LoopOptions {
+            max_frames: opts.frames,
+            blade: BladeOffset::default(),
+            haptic: &haptic,
+            nominal_pacing,
+            record: true,
+            tray,
+        },
+    )?;
+    outcome.log.save(&opts.out.join("frames.csv"))?;
+    let mut stroke_path = None;
+    if let Some(stroke) = &outcome.stroke {
+        let p = opts.out.join("stroke.ron");
+        stroke.save(&p)?;
+        if let Some(extra) = &opts.record_stroke {
+            stroke.save(extra)?;
+        }
+        stroke_path = Some(p.display().to_string());
+    }
+    let quant = |q| outcome.log.frame_ms_quantile(q);
+    let report = XrReport {
+        scene: opts.scene.display().to_string(),
+        headset: describe,
+        solver_device: xr.body.device(),
+        frames: outcome.frames,
+        rendered: outcome.rendered,
+        sim_frames: outcome.sim_frames,
+        released_tets: outcome.released_tets,
+        max_tool_force: outcome.max_tool_force,
+        max_haptic: outcome.max_haptic,
+        dropped_time_s: outcome.dropped_time,
+        substeps: (xr.nominal_substeps(), outcome.min_substeps_used),
+        frame_ms_p50_p95: quant(0.5).zip(quant(0.95)),
+        solver_resets: outcome.solver_resets,
+        exit: match outcome.exit {
+            Some(e) => format!("{e:?}"),
+            None => "the runtime never made the session ready".into(),
+        },
+        stroke: stroke_path,
+    };
+    let json = serde_json::to_string_pretty(&report)?;
+    let path = opts.out.join("xr_report.json");
+    std::fs::write(&path, json).with_context(|| format!("writing {}", path.display()))?;
+    Ok(report)
+}
+
+impl XrReport {
+    /// One line for the terminal.
+    pub fn summary(&self) -> String {
+        format!(
+            "{} display frames ({} rendered), {} simulation frames, {} tets released, tool force up to {:.2} N, exit {}",
+            self.frames,
+            self.rendered,
+            self.sim_frames,
+            self.released_tets,
+            self.max_tool_force,
+            self.exit
+        )
+    }
+}

@@ -1,0 +1,327 @@
+//! A headset without a runtime: the script's head and controller poses on a virtual
+//! display clock, both eyes rendered offscreen (lavapipe without a GPU) into
+//! one texture per eye, and a scripted session lifecycle (READY … FOCUSED at the start,
+//! STOPPING → IDLE → EXITING at the end), so the XR frame loop runs unchanged.
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use glam::Vec2;
+use incise_scalpel::Stroke;
+use incise_xr::openxr::backdrop::Backdrop;
+use incise_xr::openxr::controls::ControllerState;
+use incise_xr::openxr::haptics::HapticPulse;
+use incise_xr::openxr::lifecycle::{FrameStage, Lifecycle, SessionPhase};
+use incise_xr::openxr::scalpel_pose::{BladeOffset, grip_for_scalpel};
+use incise_xr::openxr::tray::Tray;
+use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, XrError};
+use incise_xr::{RenderDevice, RenderError, RgbaImage};
+
+use super::script::{Button, HeadsetScript, RightTrack, stage_pose_at, track_at};
+
+/// Eye texture format (as the XR swapchain's).
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+/// The simulated headset.
+pub struct SimulatedHeadset {
+    script: HeadsetScript,
+    tool_track: Option<(f64, Stroke)>,
+    tray: Tray,
+    offset: BladeOffset,
+    dev: RenderDevice,
+    textures: [wgpu::Texture; 2],
+    views: [wgpu::TextureView; 2],
+    frame: u64,
+    lifecycle: Lifecycle,
+    events: VecDeque<SessionPhase>,
+    stopping: bool,
+    out: PathBuf,
+    /// Eye images written so far.
+    pub saved: Vec<PathBuf>,
+    /// Vibration pulses received (frame, amplitude).
+    pub pulses: Vec<(u64, f32)>,
+}
+
+impl SimulatedHeadset {
+    /// A headset playing `script`, rendering on `dev`; a `Tool` right track is carried
+    /// to grip poses through `tray` and `offset`; eye images go to `out`.
+    pub fn new(
+        script: HeadsetScript,
+        tool_stroke: Option<Stroke>,
+        tray: Tray,
+        offset: BladeOffset,
+        dev: RenderDevice,
+        out: &Path,
+    ) -> Result<Self> {
+        let (w, h) = script.eye_size;
+        let max = dev.limits.max_texture_dimension_2d;
+        if w > max || h > max {
+            return Err(RenderError::BadSize {
+                width: w,
+                height: h,
+                why: format!("{} allows at most {max} pixels a side", dev.info.name),
+            }
+            .into());
+        }
+        // One texture per eye, as the XR session's one swapchain per eye.
+        let textures = [0, 1].map(|_| {
+            dev.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("simulated headset eye"),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        });
+        let views =
+            [0, 1].map(|i| textures[i].create_view(&wgpu::TextureViewDescriptor::default()));
+        let start = match &script.right {
+            Some(RightTrack::Tool { start, .. }) => *start,
+            _ => 0.0,
+        };
+        Ok(SimulatedHeadset {
+            tool_track: tool_stroke.map(|s| (start, s)),
+            script,
+            tray,
+            offset,
+            dev,
+            textures,
+            views,
+            frame: 0,
+            lifecycle: Lifecycle::new(),
+            events: VecDeque::from([
+                SessionPhase::Ready,
+                SessionPhase::Synchronized,
+                SessionPhase::Visible,
+                SessionPhase::Focused,
+            ]),
+            stopping: false,
+            out: out.to_path_buf(),
+            saved: Vec::new(),
+            pulses: Vec::new(),
+        })
+    }
+
+    /// Display frames begun so far.
+    pub fn frames(&self) -> u64 {
+        self.frame
+    }
+
+    fn stop(&mut self) {
+        if !self.stopping {
+            self.stopping = true;
+            self.events.extend([
+                SessionPhase::Visible,
+                SessionPhase::Synchronized,
+                SessionPhase::Stopping,
+                SessionPhase::Idle,
+                SessionPhase::Exiting,
+            ]);
+        }
+    }
+
+    fn controllers(&self, t: f64) -> ControllerState {
+        let s = &self.script;
+        let right_grip = match (&s.right, &self.tool_track) {
+            (Some(RightTrack::Grip(keys)), _) => stage_pose_at(keys, t),
+            (Some(RightTrack::Tool { .. }), Some((start, stroke))) => {
+                let rel = t - start;
+                (rel >= 0.0 && rel <= stroke.end_time())
+                    .then(|| grip_for_scalpel(stroke.pose_at(rel), self.offset, &self.tray))
+            }
+            _ => None,
+        };
+        let half = 0.5 * s.period();
+        let pressed = |b: Button| {
+            s.buttons
+                .iter()
+                .any(|(bt, x)| *x == b && (t - bt).abs() < half)
+        };
+        ControllerState {
+            right_grip,
+            trigger: track_at(&s.trigger, t, 0.0),
+            a: pressed(Button::A),
+            b: pressed(Button::B),
+            left_grip: stage_pose_at(&s.left, t),
+            squeeze: track_at(&s.squeeze, t, 0.0),
+            stick: track_at(&s.stick, t, Vec2::ZERO),
+            menu: pressed(Button::Menu),
+        }
+    }
+
+    fn save_eyes(&mut self) -> Result<(), XrError> {
+        for (eye, name) in [(0, "left"), (1, "right")] {
+            let img = read_texture(&self.dev, &self.textures[eye])?;
+            let path = self.out.join(format!("eye_{name}_{:05}.png", self.frame));
+            img.save_png(&path)?;
+            self.saved.push(path);
+        }
+        Ok(())
+    }
+}
+
+impl Headset for SimulatedHeadset {
+    fn device(&self) -> &RenderDevice {
+        &self.dev
+    }
+
+    fn eye_size(&self) -> (u32, u32) {
+        self.script.eye_size
+    }
+
+    fn backdrop(&self) -> Backdrop {
+        if self.script.passthrough {
+            Backdrop::Passthrough
+        } else {
+            Backdrop::Opaque
+        }
+    }
+
+    fn format(&self) -> wgpu::TextureFormat {
+        FORMAT
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "simulated headset ({}×{} per eye at {} Hz) on {}",
+            self.script.eye_size.0,
+            self.script.eye_size.1,
+            self.script.display_hz,
+            self.dev.describe()
+        )
+    }
+
+    fn next_frame(&mut self) -> Result<FrameEvent, XrError> {
+        let t = self.frame as f64 * self.script.period();
+        if t >= self.script.duration {
+            self.stop();
+        }
+        // Poll: every pending state change, as xrPollEvent would deliver them.
+        while let Some(p) = self.events.pop_front() {
+            // Begin/end session, release and end-frame calls have no runtime to go to.
+            let _ = self.lifecycle.on_state(p);
+        }
+        if let Some(why) = self.lifecycle.finished() {
+            return Ok(FrameEvent::Ended(why));
+        }
+        if !self.lifecycle.wants_frame() {
+            return Ok(FrameEvent::Idle);
+        }
+        self.lifecycle.begin_frame()?;
+        let head = stage_pose_at(&self.script.head, t)
+            .or_else(|| {
+                let last = self.script.head.last()?;
+                Some(incise_xr::openxr::pose::XrPose::new(
+                    last.position,
+                    last.orientation,
+                ))
+            })
+            .unwrap_or_default();
+        let focused = self.lifecycle.is_focused();
+        Ok(FrameEvent::Frame(Box::new(HeadsetFrame {
+            display_time: t,
+            display_period: self.script.period(),
+            should_render: self.lifecycle.is_visible()
+                && self.frame % self.script.render_every == 0,
+            eyes: self.script.eyes(head),
+            controllers: if focused {
+                self.controllers(t)
+            } else {
+                ControllerState::default()
+            },
+            focused,
+        })))
+    }
+
+    fn acquire(&mut self) -> Result<[wgpu::TextureView; 2], XrError> {
+        self.lifecycle.acquire_image()?;
+        Ok(self.views.clone())
+    }
+
+    fn end_frame(&mut self, rendered: bool) -> Result<(), XrError> {
+        if self.lifecycle.stage() == FrameStage::Acquired {
+            self.lifecycle.release_image()?;
+        }
+        if rendered && self.script.screenshots.contains(&self.frame) {
+            self.save_eyes()?;
+        }
+        self.lifecycle.end_frame()?;
+        self.frame += 1;
+        Ok(())
+    }
+
+    fn vibrate(&mut self, pulse: Option<HapticPulse>) -> Result<(), XrError> {
+        if let Some(p) = pulse {
+            self.pulses.push((self.frame, p.amplitude));
+        }
+        Ok(())
+    }
+
+    fn request_exit(&mut self) -> Result<(), XrError> {
+        self.stop();
+        Ok(())
+    }
+}
+
+/// Read `texture` back as an image (waits for the device).
+fn read_texture(dev: &RenderDevice, texture: &wgpu::Texture) -> Result<RgbaImage, RenderError> {
+    let (w, h) = (texture.width(), texture.height());
+    let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let staging = dev.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("eye readback"),
+        size: row as u64 * h as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = dev
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    dev.queue.submit([enc.finish()]);
+    let slice = staging.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    dev.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let mut pixels = Vec::with_capacity((w * h * 4) as usize);
+    for y in 0..h as usize {
+        let start = y * row as usize;
+        pixels.extend_from_slice(&bytes[start..start + w as usize * 4]);
+    }
+    Ok(RgbaImage {
+        width: w,
+        height: h,
+        pixels,
+    })
+}

@@ -1,0 +1,293 @@
+//! The simulated organ in the XR mode: the scene's solver with the scalpel attached
+//! (sharp while the trigger is held, dull otherwise), its substeps changeable by the
+//! pacer, and a reset to the scene's rest state.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use glam::{Quat, Vec3};
+use incise_sim::contact::{ContactTool, ToolPose};
+use incise_sim::skin::Skin;
+use incise_sim::xpbd::{FrameStats, stiffness_number, substeps_needed};
+use incise_sim::{Material, Solver};
+use incise_xr::RenderDevice;
+use incise_xr::frame::pinned_nodes;
+
+use crate::body::{Body, DeviceChoice};
+use crate::scene::{BuiltScene, Scene, build_scene, load_scene};
+use crate::screenshots::place_on;
+
+/// The scalpel used when the scene names none, relative to the scene file.
+pub const DEFAULT_TOOL: &str = "tools/scalpel_10.ron";
+
+/// The organ, its scalpel and how to rebuild them.
+pub struct XrBody {
+    /// The solver on its device.
+    pub body: Body,
+    scene: Scene,
+    path: PathBuf,
+    device: DeviceChoice,
+    dev: RenderDevice,
+    material: Material,
+    sharp: ContactTool,
+    tool: incise_scalpel::Tool,
+    engaged: bool,
+    tracked: bool,
+    pose: ToolPose,
+    has_grabs: bool,
+    nominal: u32,
+    min_substeps: u32,
+}
+
+/// The contact tool of `scene` (its own scalpel, else [`DEFAULT_TOOL`]) for `solver`.
+fn scalpel(
+    scene: &Scene,
+    path: &Path,
+    solver: &Solver,
+) -> Result<(incise_scalpel::Tool, ContactTool)> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let (file, dull) = match &scene.tool {
+        Some(t) => (dir.join(&t.file), t.dull),
+        None => (dir.join(DEFAULT_TOOL), false),
+    };
+    let tool = incise_scalpel::load_tool(&file)
+        .with_context(|| format!("{}: the XR scalpel", path.display()))?;
+    let contact = tool.contact_tool(solver.mesh().mean_edge_length());
+    Ok((tool, if dull { contact.dulled() } else { contact }))
+}
+
+/// Where the scalpel waits until the controller is tracked: 1 m above the organ.
+fn parked(solver: &Solver) -> ToolPose {
+    let (lo, hi) = solver.mesh().rest_bounds();
+    let c = (lo + hi) * 0.5;
+    ToolPose {
+        position: Vec3::new(c.x, c.y, hi.z + 1.0),
+        rotation: Quat::IDENTITY,
+    }
+}
+
+impl XrBody {
+    /// Load the scene at `path` for the XR mode; the body runs on `device` (a GPU body on
+    /// `dev`). Returns the body and the skin to render.
+    pub fn load(path: &Path, device: DeviceChoice, dev: &RenderDevice) -> Result<(XrBody, Skin)> {
+        let mut scene = load_scene(path)?;
+        // The controller drives the scalpel; the scene's own stroke is not used.
+        let own_tool = scene.tool.take();
+        scene.stroke = None;
+        let BuiltScene {
+            mut solver,
+            skin,
+            material,
+            grabbed_nodes,
+            ..
+        } = build_scene(&scene, path, None)?;
+        scene.tool = own_tool;
+        let (tool, sharp) = scalpel(&scene, path, &solver)?;
+        let pose = parked(&solver);
+        solver.set_tool(sharp.dulled(), pose)?;
+        let nominal = solver.params().substeps;
+        let inv_mass: Vec<f32> = solver
+            .masses()
+            .iter()
+            .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
+            .collect();
+        let (kappa, _) = stiffness_number(
+            solver.mesh(),
+            &inv_mass,
+            solver.lame(),
+            solver.params().substep(),
+        );
+        let min_substeps = substeps_needed(kappa, nominal).clamp(1, nominal);
+        let body = place_on(solver, device, dev)?;
+        Ok((
+            XrBody {
+                body,
+                scene,
+                path: path.to_path_buf(),
+                device,
+                dev: dev.clone(),
+                material,
+                sharp,
+                tool,
+                engaged: false,
+                tracked: false,
+                pose,
+                has_grabs: grabbed_nodes > 0,
+                nominal,
+                min_substeps,
+            },
+            skin,
+        ))
+    }
+
+    /// The solver (or the GPU solver's host mirror).
+    pub fn solver(&self) -> &Solver {
+        self.body.solver()
+    }
+
+    /// The scalpel model (for scripted incisions).
+    pub fn scalpel(&self) -> &incise_scalpel::Tool {
+        &self.tool
+    }
+
+    /// The scene's substeps.
+    pub fn nominal_substeps(&self) -> u32 {
+        self.nominal
+    }
+
+    /// The fewest stable substeps; the nominal count when the scene has scripted grabs
+    /// (a rebuilt solver would restart them).
+    pub fn min_substeps(&self) -> u32 {
+        if self.has_grabs {
+            self.nominal
+        } else {
+            self.min_substeps
+        }
+    }
+
+    /// The scalpel's last pose, and whether the controller is tracked.
+    pub fn tool(&self) -> (ToolPose, bool) {
+        (self.pose, self.tracked)
+    }
+
+    fn contact(&self) -> ContactTool {
+        if self.engaged {
+            self.sharp.clone()
+        } else {
+            self.sharp.dulled()
+        }
+    }
+
+    fn set_tool(&mut self) -> Result<()> {
+        let (c, p) = (self.contact(), self.pose);
+        match &mut self.body {
+            Body::Cpu(s) => s.set_tool(c, p)?,
+            Body::Gpu(g) => g.set_tool(c, p)?,
+        }
+        Ok(())
+    }
+
+    /// Drive the scalpel for the next simulation frame: to `pose` (sim world) while the
+    /// controller is tracked, cutting only while `engaged`. When tracking starts the tool
+    /// is placed there at once (no sweep from where it waited); untracked, it stays.
+    pub fn drive_tool(&mut self, pose: Option<ToolPose>, engaged: bool) -> Result<()> {
+        let Some(pose) = pose else {
+            self.tracked = false;
+            return Ok(());
+        };
+        let start = !self.tracked;
+        self.tracked = true;
+        self.pose = pose;
+        if start || engaged != self.engaged {
+            self.engaged = engaged;
+            self.set_tool()
+        } else {
+            self.body.move_tool(pose);
+            Ok(())
+        }
+    }
+
+    /// Step one simulation frame.
+    pub fn step(&mut self) -> Result<FrameStats> {
+        Ok(self.body.step_frame()?)
+    }
+
+    /// Run `substeps` per frame from now on: the solver is rebuilt with the same state
+    /// (positions, released tets, pins, tool; velocities restart from rest).
+    pub fn set_substeps(&mut self, substeps: u32) -> Result<()> {
+        let old = self.body.solver();
+        if substeps == old.params().substeps {
+            return Ok(());
+        }
+        let mut params = old.params().clone();
+        params.substeps = substeps;
+        let mut s = Solver::new(old.mesh().clone(), self.material, params)
+            .with_context(|| format!("{}: {substeps} substeps", self.path.display()))?;
+        s.set_positions(old.positions());
+        let released: Vec<u32> = (0..old.mesh().tet_count())
+            .filter(|&i| !old.cut().is_live(i))
+            .map(|i| i as u32)
+            .collect();
+        s.release(&released);
+        s.pin(&pinned_nodes(old));
+        s.set_tool(self.contact(), self.pose)?;
+        self.body = place_on(s, self.device, &self.dev)?;
+        Ok(())
+    }
+
+    /// Back to the scene's rest state (A button); the scalpel waits until tracked.
+    pub fn reset(&mut self) -> Result<()> {
+        let BuiltScene { mut solver, .. } =
+            build_scene(&self.scene_without_stroke(), &self.path, None)?;
+        self.pose = parked(&solver);
+        self.tracked = false;
+        self.engaged = false;
+        solver.set_tool(self.sharp.dulled(), self.pose)?;
+        self.body = place_on(solver, self.device, &self.dev)?;
+        Ok(())
+    }
+
+    fn scene_without_stroke(&self) -> Scene {
+        Scene {
+            tool: None,
+            stroke: None,
+            ..self.scene.clone()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fewer_substeps_keep_state_and_tool_and_reset_goes_back_to_rest() {
+        let dev = match RenderDevice::headless() {
+            Ok(d) => d,
+            Err(e) => {
+                eprintln!("skipping: {e}");
+                return;
+            }
+        };
+        let (mut xr, _) =
+            XrBody::load(Path::new("config/plate_cut.ron"), DeviceChoice::Cpu, &dev).unwrap();
+        let nominal = xr.nominal_substeps();
+        let min = xr.min_substeps();
+        assert!(
+            min >= 1 && min < nominal,
+            "plate_cut is stable below its {nominal} substeps: {min}"
+        );
+        // Blade resting on the top, engaged, and a few frames of sag under gravity.
+        let pose = ToolPose {
+            position: Vec3::new(0.04, 0.02, 0.021),
+            rotation: Quat::IDENTITY,
+        };
+        for _ in 0..3 {
+            xr.drive_tool(Some(pose), true).unwrap();
+            xr.step().unwrap();
+        }
+        let before = xr.solver().positions().to_vec();
+        let rest = xr.solver().mesh().rest_positions.clone();
+        let pins = pinned_nodes(xr.solver());
+        assert!(!pins.is_empty());
+        assert!(
+            before
+                .iter()
+                .zip(&rest)
+                .any(|(a, b)| (*a - *b).length() > 1e-7)
+        );
+        xr.set_substeps(min).unwrap();
+        let s = xr.solver();
+        assert_eq!(s.params().substeps, min);
+        assert_eq!(s.positions(), &before[..]);
+        assert_eq!(pinned_nodes(s), pins, "pins kept");
+        let motion = s.tool().expect("the scalpel stays attached");
+        assert_eq!(motion.to, pose);
+        xr.step().unwrap();
+        // Reset: rest positions, nominal substeps, the scalpel waiting until tracked.
+        xr.reset().unwrap();
+        assert_eq!(xr.solver().positions(), &rest[..]);
+        assert_eq!(xr.solver().params().substeps, nominal);
+        assert!(!xr.tool().1);
+    }
+}
