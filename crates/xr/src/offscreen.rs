@@ -1,4 +1,4 @@
-//! Rendering without a window: into a texture (one layer per eye) that can be read back
+//! Rendering without a window: into one texture per eye that can be read back
 //! as an image — screenshots, golden-image tests and the benchmark.
 
 use incise_sim::TetMesh;
@@ -14,14 +14,16 @@ use crate::renderer::{Renderer, read_buffer};
 /// Colour format of offscreen images: 8-bit sRGB.
 pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
-/// A renderer with its own target texture of `layers` eyes.
+/// A renderer with its own target textures, one per eye. (One texture per eye, not the
+/// layers of an array texture: on lavapipe a pass into layer 1 of a 2-layer texture
+/// wrote into layer 0, leaving the second eye blank.)
 pub struct OffscreenRenderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
     /// The renderer (for timing and skin readback).
     pub renderer: Renderer,
     size: (u32, u32),
-    texture: wgpu::Texture,
+    textures: Vec<wgpu::Texture>,
     layer_views: Vec<wgpu::TextureView>,
 }
 
@@ -48,36 +50,34 @@ impl OffscreenRenderer {
         if !(1..=4).contains(&layers) {
             return Err(bad(format!("1 to 4 eyes, not {layers}")));
         }
-        let texture = dev.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("offscreen target"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: layers,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: OFFSCREEN_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let layer_views = (0..layers)
-            .map(|l| {
-                texture.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: l,
-                    array_layer_count: Some(1),
-                    ..Default::default()
+        let textures: Vec<wgpu::Texture> = (0..layers)
+            .map(|_| {
+                dev.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("offscreen target"),
+                    size: wgpu::Extent3d {
+                        width,
+                        height,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: OFFSCREEN_FORMAT,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
                 })
             })
+            .collect();
+        let layer_views = textures
+            .iter()
+            .map(|t| t.create_view(&wgpu::TextureViewDescriptor::default()))
             .collect();
         Ok(OffscreenRenderer {
             renderer: Renderer::new(&dev.device, &dev.queue, OFFSCREEN_FORMAT, mesh, skin),
             device: dev.device.clone(),
             queue: dev.queue.clone(),
             size: (width, height),
-            texture,
+            textures,
             layer_views,
         })
     }
@@ -115,9 +115,15 @@ impl OffscreenRenderer {
             .map_err(|e| RenderError::Readback(e.to_string()))
     }
 
-    /// Read layer `layer` of the target back as an image (waits for the device).
+    /// Read eye `layer`'s target back as an image (waits for the device).
     pub fn read_image(&self, layer: u32) -> Result<RgbaImage, RenderError> {
         let (w, h) = self.size;
+        let texture = self.textures.get(layer as usize).ok_or_else(|| {
+            RenderError::Readback(format!(
+                "no eye {layer}: the target has {}",
+                self.textures.len()
+            ))
+        })?;
         let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("image readback"),
@@ -130,13 +136,9 @@ impl OffscreenRenderer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
         enc.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
-                texture: &self.texture,
+                texture,
                 mip_level: 0,
-                origin: wgpu::Origin3d {
-                    x: 0,
-                    y: 0,
-                    z: layer,
-                },
+                origin: wgpu::Origin3d::ZERO,
                 aspect: wgpu::TextureAspect::All,
             },
             wgpu::TexelCopyBufferInfo {

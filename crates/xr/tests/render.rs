@@ -316,3 +316,50 @@ fn gpu_skin_equals_its_barycentric_combination_after_a_large_deformation() {
         .fold(0.0f32, f32::max);
     assert!(moved > 0.05, "{moved}");
 }
+
+/// Stereo offscreen (the Quest benchmark and screenshots): both eyes are drawn, each into
+/// its own target, and they differ by the eyes' separation. (With one 2-layer array
+/// texture, lavapipe drew the second eye into layer 0 and left layer 1 blank.)
+#[test]
+fn both_eyes_of_a_stereo_target_are_drawn() {
+    let Some(dev) = device() else {
+        return;
+    };
+    let mesh = TetMesh::from_raw(block(Vec3::ZERO, Vec3::splat(0.02), UVec3::new(2, 2, 2)))
+        .unwrap()
+        .0;
+    let skin = Skin::from_boundary(&mesh);
+    let cut = CutState::new(&mesh);
+    let vm = vec![0.0; mesh.tet_count()];
+    let state = BodyState {
+        positions: &mesh.rest_positions,
+        device_positions: None,
+        cut: &cut,
+        von_mises: &vm,
+        pinned: &[],
+    };
+    let (lo, hi) = mesh.rest_bounds();
+    let centre = Camera::framing(lo, hi, -1.0, 0.5).view(4.0 / 3.0);
+    let right = centre.view.inverse().x_axis.truncate();
+    let eyes: Vec<View> = [-0.005f32, 0.005]
+        .iter()
+        .map(|&d| View {
+            view: centre.view * glam::Mat4::from_translation(-right * d),
+            proj: centre.proj,
+        })
+        .collect();
+    let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 2).unwrap();
+    r.render(&state, &RenderSettings::default(), &eyes);
+    let (left, right_img) = (r.read_image(0).unwrap(), r.read_image(1).unwrap());
+    let background = left.pixels[..4].to_vec();
+    let drawn = |img: &RgbaImage| {
+        img.pixels
+            .chunks(4)
+            .filter(|p| *p != &background[..])
+            .count()
+    };
+    assert!(drawn(&left) > 1000, "the left eye is blank");
+    assert!(drawn(&right_img) > 1000, "the right eye is blank");
+    assert_ne!(left.pixels, right_img.pixels, "the eyes see the same image");
+    assert!(r.read_image(2).is_err(), "there is no third eye");
+}
