@@ -15,6 +15,9 @@ use crate::report::{FrameData, FrameRecord, MaterialInfo, MeshInfo, Report, Tool
 use crate::scene::{BuiltScene, ToolDriver, build_scene_driven, load_scene};
 use crate::screenshots::{ImageSize, Screenshots};
 
+/// Frames between checkpoints of report.json and the recorded stroke (1 s at 60 Hz).
+pub const CHECKPOINT_FRAMES: u64 = 60;
+
 /// Options of `incise run`.
 #[derive(Debug, Clone)]
 pub struct RunOptions {
@@ -270,6 +273,14 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         }
         if opts.vtu_every > 0 && (f + 1) % opts.vtu_every == 0 {
             snapshot(&opts.out, body.solver(), f + 1, &mut pvd)?;
+        }
+        if (f + 1) % CHECKPOINT_FRAMES == 0 {
+            // A run that is killed keeps its report and stroke up to here (status
+            // "running"); both are written atomically.
+            report.write(&report_path)?;
+            if let (Some(r), Some(path)) = (&recorder, &opts.record_stroke) {
+                r.clone().finish()?.save(path)?;
+            }
         }
         if let Some(s) = shots
             .as_mut()

@@ -1,7 +1,9 @@
 //! Issue 11: outputs are atomic. `incise run` is killed with SIGKILL at pseudo-random
-//! moments, 40 times (10 more runs finish); afterwards every output file is either absent or complete and
-//! parseable (report.json, every .vtu snapshot, run.pvd, the recorded stroke). Leftover
-//! `.tmp` siblings are allowed: they are never read and the next write replaces them.
+//! moments, 40 times (10 more runs finish); afterwards every output file is either absent
+//! or complete and parseable (report.json, every .vtu snapshot, run.pvd, the recorded
+//! stroke). Leftover `.tmp` siblings are allowed: they are never read and the next write
+//! replaces them. Report and stroke are checkpointed every second of simulated time, so a
+//! killed run keeps them up to its last checkpoint.
 
 mod common;
 
@@ -110,4 +112,44 @@ fn a_run_killed_at_any_moment_leaves_only_complete_files() {
         reports > 0,
         "no run finished before its kill, so report.json was not tested"
     );
+}
+
+/// A long run killed after its first checkpoint keeps a parseable report (status
+/// "running", every frame up to the checkpoint) and the stroke recorded so far.
+#[test]
+fn a_killed_run_keeps_its_checkpointed_report_and_stroke() {
+    let out = temp_dir("atomic-checkpoint");
+    let stroke = out.join("stroke.ron");
+    let mut child = incise_command(&[
+        "run",
+        "config/plate_cut.ron",
+        "--device",
+        "cpu",
+        "--frames",
+        "100000",
+        "--vtu-every",
+        "0",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--record-stroke",
+        stroke.to_str().unwrap(),
+    ])
+    .stdout(std::process::Stdio::null())
+    .stderr(std::process::Stdio::null())
+    .spawn()
+    .expect("incise starts");
+    let report = out.join("report.json");
+    let t = std::time::Instant::now();
+    while !(report.exists() && stroke.exists()) && t.elapsed() < Duration::from_secs(300) {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("a checkpoint")).unwrap();
+    assert_eq!(r["status"], "running");
+    assert!(r["frames"].as_array().unwrap().len() >= 60);
+    let s = incise_scalpel::load_stroke(&stroke).expect("the stroke so far parses");
+    assert!(s.keys().len() >= 61, "{} keys", s.keys().len());
 }
