@@ -296,13 +296,6 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         write_pvd(&opts.out.join("run.pvd"), &pvd)?;
         report.snapshots = pvd.iter().map(|(_, f)| f.clone()).collect();
     }
-    report.status = if failure.is_some() {
-        "failed"
-    } else {
-        "completed"
-    }
-    .into();
-    report.error = failure.as_ref().map(|e| e.to_string());
     let cut = body.solver().cut();
     report.released_tets = (0..body.solver().mesh().tet_count() as u32)
         .filter(|&t| !cut.is_live(t as usize))
@@ -310,6 +303,25 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     if let (Some(r), Some(path)) = (recorder, &opts.record_stroke) {
         r.finish()?.save(path)?;
     }
+    finish(report, report_path, failure.map(|e| e.to_string()), opts)
+}
+
+/// Record how the run ended in `report` ("completed", or "failed" with the error), write
+/// it, and return the outcome; after a failure, the error, naming the scene and saying
+/// that the output written so far is kept.
+pub fn finish(
+    mut report: Report,
+    report_path: PathBuf,
+    failure: Option<String>,
+    opts: &RunOptions,
+) -> Result<RunOutcome> {
+    report.status = if failure.is_some() {
+        "failed"
+    } else {
+        "completed"
+    }
+    .into();
+    report.error = failure.clone();
     report.write(&report_path)?;
     if let Some(e) = failure {
         bail!(

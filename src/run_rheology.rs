@@ -227,25 +227,7 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
         info.max_dent_m = max_dent;
         info.residual_dent_m = dent;
     }
-    report.status = if failure.is_some() {
-        "failed"
-    } else {
-        "completed"
-    }
-    .into();
-    report.error = failure.as_ref().map(|e| e.to_string());
-    report.write(&report_path)?;
-    if let Some(e) = failure {
-        bail!(
-            "{}: {e} (output so far kept in {})",
-            opts.scene.display(),
-            opts.out.display()
-        );
-    }
-    Ok(RunOutcome {
-        report_path,
-        report,
-    })
+    crate::run::finish(report, report_path, failure.map(|e| e.to_string()), opts)
 }
 
 /// Tet and edge counts per material (index 0: the default, k: region k − 1).

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use glam::Vec2;
 use incise_scalpel::Stroke;
+use incise_xr::offscreen::read_texture;
 use incise_xr::openxr::backdrop::Backdrop;
 use incise_xr::openxr::controls::ControllerState;
 use incise_xr::openxr::haptics::HapticPulse;
@@ -16,7 +17,7 @@ use incise_xr::openxr::lifecycle::{FrameStage, Lifecycle, SessionPhase};
 use incise_xr::openxr::scalpel_pose::{BladeOffset, grip_for_scalpel};
 use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, XrError};
-use incise_xr::{RenderDevice, RenderError, RgbaImage};
+use incise_xr::{RenderDevice, RenderError};
 
 use super::script::{Button, HeadsetScript, RightTrack, stage_pose_at, track_at};
 
@@ -159,7 +160,7 @@ impl SimulatedHeadset {
 
     fn save_eyes(&mut self) -> Result<(), XrError> {
         for (eye, name) in [(0, "left"), (1, "right")] {
-            let img = read_texture(&self.dev, &self.textures[eye])?;
+            let img = read_texture(&self.dev.device, &self.dev.queue, &self.textures[eye])?;
             let path = self.out.join(format!("eye_{name}_{:05}.png", self.frame));
             img.save_png(&path)?;
             self.saved.push(path);
@@ -269,59 +270,4 @@ impl Headset for SimulatedHeadset {
         self.stop();
         Ok(())
     }
-}
-
-/// Read `texture` back as an image (waits for the device).
-fn read_texture(dev: &RenderDevice, texture: &wgpu::Texture) -> Result<RgbaImage, RenderError> {
-    let (w, h) = (texture.width(), texture.height());
-    let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-    let staging = dev.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("eye readback"),
-        size: row as u64 * h as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = dev
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-    enc.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &staging,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: Some(h),
-            },
-        },
-        wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-    );
-    dev.queue.submit([enc.finish()]);
-    let slice = staging.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
-    dev.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let bytes = slice
-        .get_mapped_range()
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let mut pixels = Vec::with_capacity((w * h * 4) as usize);
-    for y in 0..h as usize {
-        let start = y * row as usize;
-        pixels.extend_from_slice(&bytes[start..start + w as usize * 4]);
-    }
-    Ok(RgbaImage {
-        width: w,
-        height: h,
-        pixels,
-    })
 }

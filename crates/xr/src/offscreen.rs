@@ -117,56 +117,13 @@ impl OffscreenRenderer {
 
     /// Read eye `layer`'s target back as an image (waits for the device).
     pub fn read_image(&self, layer: u32) -> Result<RgbaImage, RenderError> {
-        let (w, h) = self.size;
         let texture = self.textures.get(layer as usize).ok_or_else(|| {
             RenderError::Readback(format!(
                 "no eye {layer}: the target has {}",
                 self.textures.len()
             ))
         })?;
-        let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("image readback"),
-            size: row as u64 * h as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
-        self.queue.submit([enc.finish()]);
-        let bytes = read_buffer(&self.device, &staging)?;
-        let mut pixels = Vec::with_capacity((w * h * 4) as usize);
-        for y in 0..h as usize {
-            let start = y * row as usize;
-            pixels.extend_from_slice(&bytes[start..start + w as usize * 4]);
-        }
-        Ok(RgbaImage {
-            width: w,
-            height: h,
-            pixels,
-        })
+        read_texture(&self.device, &self.queue, texture)
     }
 
     /// Render one view into layer 0 and read it back.
@@ -179,4 +136,55 @@ impl OffscreenRenderer {
         self.render(state, settings, std::slice::from_ref(view));
         self.read_image(0)
     }
+}
+
+/// Read a whole single-layer RGBA8 `texture` back as an image (waits for the device):
+/// offscreen targets and the simulated headset's eye textures.
+pub fn read_texture(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+) -> Result<RgbaImage, RenderError> {
+    let (w, h) = (texture.width(), texture.height());
+    let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("image readback"),
+        size: row as u64 * h as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    queue.submit([enc.finish()]);
+    let bytes = read_buffer(device, &staging)?;
+    let mut pixels = Vec::with_capacity((w * h * 4) as usize);
+    for y in 0..h as usize {
+        let start = y * row as usize;
+        pixels.extend_from_slice(&bytes[start..start + w as usize * 4]);
+    }
+    Ok(RgbaImage {
+        width: w,
+        height: h,
+        pixels,
+    })
 }
