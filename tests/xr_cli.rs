@@ -233,3 +233,79 @@ fn with_passthrough_the_room_shows_around_the_organ() {
         .count();
     assert!(opaque > 30, "the organ is opaque: {opaque} pixels");
 }
+
+/// The plate-cut script at a small eye size, drawing every 9th frame, with `fault`
+/// injected 1 s in (0.9 s into the stroke); runs `incise xr` on it.
+fn run_with_fault(name: &str, fault: &str) -> (std::process::Output, std::path::PathBuf) {
+    let script = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT))
+        .unwrap()
+        .replace("screenshots: [0]", "screenshots: []")
+        .replace(
+            "render_every: 1000,",
+            &format!("render_every: 9, eye_size: (96, 96), faults: [(1.0, {fault})],"),
+        );
+    let dir = temp_dir(name);
+    let path = dir.join("headset.ron");
+    std::fs::write(&path, script).unwrap();
+    let out = dir.join("out");
+    let o = incise(&[
+        "xr",
+        "config/plate_cut.ron",
+        "--simulated-headset",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    (o, out)
+}
+
+/// Issue 11: a runtime that loses the session (LOSS_PENDING, or calls failing with
+/// XR_ERROR_SESSION_LOST in the middle of a frame), goes away (instance loss) or ends the
+/// session itself shuts incise down cleanly with the stroke, the frame log and the
+/// report saved up to that moment; a runtime failure that is no clean end exits non-zero
+/// and still keeps them.
+#[test]
+fn a_lost_or_ending_runtime_stops_the_session_cleanly_and_keeps_its_outputs() {
+    for (fault, exit) in [
+        ("SessionLoss", "SessionLost"),
+        ("LostCall", "SessionLost"),
+        ("InstanceLoss", "InstanceLost"),
+        ("RuntimeExit", "Exited"),
+        ("RuntimeFailure", "failed: "),
+    ] {
+        let (o, out) = run_with_fault(&format!("xr-fault-{fault}"), fault);
+        let err = text(&o.stderr);
+        let report: Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join("xr_report.json"))
+                .unwrap_or_else(|e| panic!("{fault}: no xr_report.json ({e}): {err}")),
+        )
+        .unwrap();
+        let said = report["exit"].as_str().unwrap();
+        assert!(said.starts_with(exit), "{fault}: exit {said}: {err}");
+        if fault == "RuntimeFailure" {
+            assert_eq!(o.status.code(), Some(1), "{fault}: {err}");
+            assert!(
+                err.contains("ERROR_RUNTIME_FAILURE") && err.contains("were kept"),
+                "{fault}: {err}"
+            );
+        } else {
+            assert!(o.status.success(), "{fault}: {err}");
+        }
+        // Stopped about 1 s in (72 display frames), not at the script's 2.8 s.
+        let frames = report["frames"].as_u64().unwrap();
+        assert!((70..=80).contains(&frames), "{fault}: {frames} frames");
+        let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+        assert_eq!(csv.lines().count() as u64, frames + 1, "{fault}");
+        assert!(
+            report["released_tets"].as_u64().unwrap() > 0,
+            "{fault}: {report}"
+        );
+        // The stroke up to the fault (session time 1 s), complete and readable.
+        let stroke = incise_scalpel::load_stroke(&out.join("stroke.ron")).unwrap();
+        assert!(
+            (0.9..1.05).contains(&stroke.end_time()),
+            "{fault}: stroke ends at {} s",
+            stroke.end_time()
+        );
+    }
+}

@@ -68,7 +68,8 @@ impl FrameLog {
 
     /// Write the CSV to `path`.
     pub fn save(&self, path: &Path) -> Result<()> {
-        std::fs::write(path, self.to_csv()).with_context(|| format!("writing {}", path.display()))
+        incise_sim::io::write_atomic(path, self.to_csv().as_bytes())
+            .with_context(|| format!("writing {}", path.display()))
     }
 
     /// The `q`-quantile (0..1) of frame wall times, ms, over rendered frames.

@@ -17,7 +17,7 @@ use incise_xr::openxr::lifecycle::ExitReason;
 use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
 use incise_xr::openxr::tray::Tray;
-use incise_xr::openxr::{FrameEvent, Headset};
+use incise_xr::openxr::{FrameEvent, Headset, XrError};
 use incise_xr::{BodyState, RenderSettings, Renderer};
 
 use super::frame_log::{FrameLog, FrameRow};
@@ -74,6 +74,9 @@ pub struct LoopOutcome {
     pub stroke: Option<Stroke>,
     /// Per-frame times.
     pub log: FrameLog,
+    /// The failure that stopped the session, when it did not end cleanly (the outputs
+    /// above are still complete up to it).
+    pub error: Option<anyhow::Error>,
 }
 
 /// Run the session on `headset` until it ends.
@@ -122,148 +125,167 @@ pub fn run_loop(
         exit: None,
         stroke: None,
         log: FrameLog::default(),
+        error: None,
     };
     let (background, background_alpha) = headset.backdrop().clear();
     let mut idle = 0;
     let mut exit_asked = false;
-    loop {
-        let frame = match headset.next_frame()? {
-            FrameEvent::Ended(why) => {
+    // Every frame runs inside this closure so that a failure mid-frame still ends with
+    // the stroke, the frame log and the report saved.
+    let mut session = || -> Result<()> {
+        loop {
+            let frame = match headset.next_frame()? {
+                FrameEvent::Ended(why) => {
+                    out.exit = Some(why);
+                    break;
+                }
+                FrameEvent::Idle => {
+                    idle += 1;
+                    if idle > MAX_IDLE {
+                        break;
+                    }
+                    continue;
+                }
+                FrameEvent::Frame(f) => *f,
+            };
+            idle = 0;
+            let started = Instant::now();
+            let c = frame.controllers;
+            let cmd = commands(&previous, &c);
+            previous = c;
+            if cmd.reset {
+                xr.reset()?;
+            }
+            stress ^= cmd.toggle_stress;
+            paused ^= cmd.toggle_pause;
+            if let (true, Some(grip)) = (c.moving_tray(), c.left_grip) {
+                tray = tray.placed_at(grip);
+            }
+            tray = tray.steered(c.stick, frame.display_period as f32);
+            let engaged = c.blade_engaged();
+            let tool_pose = c.right_grip.map(|g| scalpel_pose(g, opts.blade, &tray));
+
+            // Simulation: the pacer's frames at the fixed dt, never waiting for the display.
+            let mut plan = pacer.plan(frame.display_time, frame.display_period);
+            if paused {
+                plan.sim_frames = 0;
+            }
+            if plan.substeps != xr.solver().params().substeps {
+                xr.set_substeps(plan.substeps)?;
+            }
+            let sim_start = Instant::now();
+            let mut force = 0.0f32;
+            for _ in 0..plan.sim_frames {
+                xr.drive_tool(tool_pose, engaged)?;
+                let stats = match xr.step() {
+                    Ok(s) => s,
+                    Err(e) => {
+                        // The solver gave up (a tet inverted too long): the frame is rolled
+                        // back; start the scene again rather than end the trainee's session.
+                        eprintln!("xr: {e:#}; resetting the scene");
+                        out.solver_resets += 1;
+                        xr.reset()?;
+                        break;
+                    }
+                };
+                sim_time += sim_dt;
+                force = force.max(stats.tool_force.length());
+                if let (true, Some(p)) = (opts.record, tool_pose) {
+                    recorder.push(sim_time, p)?;
+                }
+            }
+            let sim_ms = sim_start.elapsed().as_secs_f64() * 1e3;
+            if plan.sim_frames > 0 {
+                pacer.record(plan, sim_ms * 1e-3);
+                out.min_substeps_used = out.min_substeps_used.min(plan.substeps);
+            }
+            out.sim_frames += plan.sim_frames as u64;
+            out.max_tool_force = out.max_tool_force.max(force);
+
+            let amplitude = (opts.haptic)(force);
+            let pulse = haptic_pulse(amplitude, engaged, frame.display_period);
+            headset.vibrate(pulse)?;
+            let sent = pulse.map_or(0.0, |p| p.amplitude);
+            out.max_haptic = out.max_haptic.max(sent);
+
+            // Both eyes into the headset's targets.
+            let render_start = Instant::now();
+            if frame.should_render {
+                let targets = headset.acquire()?;
+                let stage_from_sim = tray.stage_from_sim();
+                let views = frame
+                    .eyes
+                    .map(|(pose, fov)| eye_view(pose, fov, stage_from_sim));
+                let solver = xr.solver();
+                let pinned = pinned_nodes(solver);
+                let (pose, tracked) = xr.tool();
+                let settings = RenderSettings {
+                    stress_max: stress_scale(solver),
+                    tool: ToolState {
+                        transform: tracked
+                            .then(|| Mat4::from_rotation_translation(pose.rotation, pose.position)),
+                        spheres: vec![],
+                    },
+                    overlays: incise_xr::Overlays {
+                        stress,
+                        ..Default::default()
+                    },
+                    background,
+                    background_alpha,
+                    ..RenderSettings::default()
+                };
+                let mut enc = dev
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                        label: Some("xr frame"),
+                    });
+                renderer.prepare(&mut enc, &BodyState::of_solver(solver, &pinned), &settings);
+                renderer.render(
+                    &mut enc,
+                    &[(views[0], &targets[0]), (views[1], &targets[1])],
+                    headset.eye_size(),
+                );
+                dev.queue.submit([enc.finish()]);
+                headset.end_frame(true)?;
+                out.rendered += 1;
+            } else {
+                headset.end_frame(false)?;
+            }
+            out.log.rows.push(FrameRow {
+                frame: out.frames,
+                display_time: frame.display_time,
+                sim_frames: plan.sim_frames,
+                substeps: plan.substeps,
+                sim_ms,
+                render_ms: render_start.elapsed().as_secs_f64() * 1e3,
+                frame_ms: started.elapsed().as_secs_f64() * 1e3,
+                rendered: frame.should_render,
+                engaged,
+                tool_force: force,
+                haptic: sent,
+            });
+            out.frames += 1;
+            if !exit_asked && opts.max_frames.is_some_and(|m| out.frames >= m) {
+                exit_asked = true;
+                headset.request_exit()?;
+            }
+        }
+        Ok(())
+    };
+
+    if let Err(e) = session() {
+        match e.downcast_ref::<XrError>().and_then(XrError::lost) {
+            // The runtime lost the session or is going away: a clean end, as on the
+            // LOSS_PENDING event.
+            Some(why) => {
+                eprintln!("xr: {e:#}: the session is over");
                 out.exit = Some(why);
-                break;
             }
-            FrameEvent::Idle => {
-                idle += 1;
-                if idle > MAX_IDLE {
-                    break;
-                }
-                continue;
-            }
-            FrameEvent::Frame(f) => *f,
-        };
-        idle = 0;
-        let started = Instant::now();
-        let c = frame.controllers;
-        let cmd = commands(&previous, &c);
-        previous = c;
-        if cmd.reset {
-            xr.reset()?;
-        }
-        stress ^= cmd.toggle_stress;
-        paused ^= cmd.toggle_pause;
-        if let (true, Some(grip)) = (c.moving_tray(), c.left_grip) {
-            tray = tray.placed_at(grip);
-        }
-        tray = tray.steered(c.stick, frame.display_period as f32);
-        let engaged = c.blade_engaged();
-        let tool_pose = c.right_grip.map(|g| scalpel_pose(g, opts.blade, &tray));
-
-        // Simulation: the pacer's frames at the fixed dt, never waiting for the display.
-        let mut plan = pacer.plan(frame.display_time, frame.display_period);
-        if paused {
-            plan.sim_frames = 0;
-        }
-        if plan.substeps != xr.solver().params().substeps {
-            xr.set_substeps(plan.substeps)?;
-        }
-        let sim_start = Instant::now();
-        let mut force = 0.0f32;
-        for _ in 0..plan.sim_frames {
-            xr.drive_tool(tool_pose, engaged)?;
-            let stats = match xr.step() {
-                Ok(s) => s,
-                Err(e) => {
-                    // The solver gave up (a tet inverted too long): the frame is rolled
-                    // back; start the scene again rather than end the trainee's session.
-                    eprintln!("xr: {e:#}; resetting the scene");
-                    out.solver_resets += 1;
-                    xr.reset()?;
-                    break;
-                }
-            };
-            sim_time += sim_dt;
-            force = force.max(stats.tool_force.length());
-            if let (true, Some(p)) = (opts.record, tool_pose) {
-                recorder.push(sim_time, p)?;
-            }
-        }
-        let sim_ms = sim_start.elapsed().as_secs_f64() * 1e3;
-        if plan.sim_frames > 0 {
-            pacer.record(plan, sim_ms * 1e-3);
-            out.min_substeps_used = out.min_substeps_used.min(plan.substeps);
-        }
-        out.sim_frames += plan.sim_frames as u64;
-        out.max_tool_force = out.max_tool_force.max(force);
-
-        let amplitude = (opts.haptic)(force);
-        let pulse = haptic_pulse(amplitude, engaged, frame.display_period);
-        headset.vibrate(pulse)?;
-        let sent = pulse.map_or(0.0, |p| p.amplitude);
-        out.max_haptic = out.max_haptic.max(sent);
-
-        // Both eyes into the headset's targets.
-        let render_start = Instant::now();
-        if frame.should_render {
-            let targets = headset.acquire()?;
-            let stage_from_sim = tray.stage_from_sim();
-            let views = frame
-                .eyes
-                .map(|(pose, fov)| eye_view(pose, fov, stage_from_sim));
-            let solver = xr.solver();
-            let pinned = pinned_nodes(solver);
-            let (pose, tracked) = xr.tool();
-            let settings = RenderSettings {
-                stress_max: stress_scale(solver),
-                tool: ToolState {
-                    transform: tracked
-                        .then(|| Mat4::from_rotation_translation(pose.rotation, pose.position)),
-                    spheres: vec![],
-                },
-                overlays: incise_xr::Overlays {
-                    stress,
-                    ..Default::default()
-                },
-                background,
-                background_alpha,
-                ..RenderSettings::default()
-            };
-            let mut enc = dev
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("xr frame"),
-                });
-            renderer.prepare(&mut enc, &BodyState::of_solver(solver, &pinned), &settings);
-            renderer.render(
-                &mut enc,
-                &[(views[0], &targets[0]), (views[1], &targets[1])],
-                headset.eye_size(),
-            );
-            dev.queue.submit([enc.finish()]);
-            headset.end_frame(true)?;
-            out.rendered += 1;
-        } else {
-            headset.end_frame(false)?;
-        }
-        out.log.rows.push(FrameRow {
-            frame: out.frames,
-            display_time: frame.display_time,
-            sim_frames: plan.sim_frames,
-            substeps: plan.substeps,
-            sim_ms,
-            render_ms: render_start.elapsed().as_secs_f64() * 1e3,
-            frame_ms: started.elapsed().as_secs_f64() * 1e3,
-            rendered: frame.should_render,
-            engaged,
-            tool_force: force,
-            haptic: sent,
-        });
-        out.frames += 1;
-        if !exit_asked && opts.max_frames.is_some_and(|m| out.frames >= m) {
-            exit_asked = true;
-            headset.request_exit()?;
+            None => out.error = Some(e),
         }
     }
-    headset.vibrate(None)?;
+    // The controller may be gone with the session: stopping its vibration can fail.
+    let _ = headset.vibrate(None);
     out.dropped_time = pacer.dropped_time();
     out.released_tets = (0..xr.solver().mesh().tet_count())
         .filter(|&i| !xr.solver().cut().is_live(i))

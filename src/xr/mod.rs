@@ -146,7 +146,7 @@ fn run_session(
     let haptic = move |f: f32| curve.amplitude(f);
     let describe = headset.describe();
     eprintln!("xr: {describe}");
-    let outcome: LoopOutcome = run_loop(
+    let mut outcome: LoopOutcome = run_loop(
         headset,
         xr,
         skin,
@@ -184,16 +184,25 @@ fn run_session(
         substeps: (xr.nominal_substeps(), outcome.min_substeps_used),
         frame_ms_p50_p95: quant(0.5).zip(quant(0.95)),
         solver_resets: outcome.solver_resets,
-        exit: match outcome.exit {
-            Some(e) => format!("{e:?}"),
-            None => "the runtime never made the session ready".into(),
+        exit: match (&outcome.error, outcome.exit) {
+            (Some(e), _) => format!("failed: {e:#}"),
+            (None, Some(e)) => format!("{e:?}"),
+            (None, None) => "the runtime never made the session ready".into(),
         },
         stroke: stroke_path,
     };
     let json = serde_json::to_string_pretty(&report)?;
     let path = opts.out.join("xr_report.json");
-    std::fs::write(&path, json).with_context(|| format!("writing {}", path.display()))?;
-    Ok(report)
+    incise_sim::io::write_atomic(&path, json.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    match outcome.error.take() {
+        Some(e) => Err(e.context(format!(
+            "the XR session failed after {} display frames; the frame log, the stroke and xr_report.json in {} were kept",
+            outcome.frames,
+            opts.out.display()
+        ))),
+        None => Ok(report),
+    }
 }
 
 impl XrReport {

@@ -69,6 +69,28 @@ pub struct HeadsetScript {
     /// Button presses (held for one display frame).
     #[serde(default)]
     pub buttons: Vec<(f64, Button)>,
+    /// Runtime faults injected at these times (issue 11: the session must end cleanly
+    /// and keep its outputs).
+    #[serde(default)]
+    pub faults: Vec<(f64, XrFault)>,
+}
+
+/// A runtime fault the simulated headset can inject.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum XrFault {
+    /// The runtime reports LOSS_PENDING (headset unplugged, Link stopped).
+    SessionLoss,
+    /// From the next frame's swapchain acquisition on, every call fails with
+    /// `XR_ERROR_SESSION_LOST` before any event says so (the cable pulled mid-frame).
+    LostCall,
+    /// The runtime reports `XrEventDataInstanceLossPending` (it is going away).
+    InstanceLoss,
+    /// The runtime ends the session on its own: STOPPING → IDLE → EXITING (the user
+    /// quit from the system menu).
+    RuntimeExit,
+    /// From the next frame's swapchain acquisition on, calls fail with
+    /// `XR_ERROR_RUNTIME_FAILURE`: a failure that is not a clean end.
+    RuntimeFailure,
 }
 
 fn default_hz() -> f64 {
@@ -212,6 +234,7 @@ impl HeadsetScript {
         check_times("trigger", self.trigger.iter().map(|k| k.0))?;
         check_times("squeeze", self.squeeze.iter().map(|k| k.0))?;
         check_times("stick", self.stick.iter().map(|k| k.0))?;
+        check_times("faults", self.faults.iter().map(|k| k.0))?;
         if let Some(RightTrack::Grip(keys)) = &self.right {
             check_times("right", keys.iter().map(|k| k.t))?;
         }

@@ -19,7 +19,7 @@ use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, XrError};
 use incise_xr::{RenderDevice, RenderError};
 
-use super::script::{Button, HeadsetScript, RightTrack, stage_pose_at, track_at};
+use super::script::{Button, HeadsetScript, RightTrack, XrFault, stage_pose_at, track_at};
 
 /// Eye texture format (as the XR swapchain's).
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -37,6 +37,10 @@ pub struct SimulatedHeadset {
     lifecycle: Lifecycle,
     events: VecDeque<SessionPhase>,
     stopping: bool,
+    /// Faults still to come, in time order.
+    faults: VecDeque<(f64, XrFault)>,
+    /// Result every runtime call returns from now on (an injected lost or failed runtime).
+    failing: Option<fn(&'static str) -> XrError>,
     out: PathBuf,
     /// Eye images written so far.
     pub saved: Vec<PathBuf>,
@@ -88,7 +92,10 @@ impl SimulatedHeadset {
             Some(RightTrack::Tool { start, .. }) => *start,
             _ => 0.0,
         };
+        let faults = script.faults.iter().copied().collect();
         Ok(SimulatedHeadset {
+            faults,
+            failing: None,
             tool_track: tool_stroke.map(|s| (start, s)),
             script,
             tray,
@@ -158,6 +165,37 @@ impl SimulatedHeadset {
         }
     }
 
+    /// Inject the faults due by `t`.
+    fn inject_faults(&mut self, t: f64) {
+        while let Some(&(at, fault)) = self.faults.front() {
+            if at > t {
+                break;
+            }
+            self.faults.pop_front();
+            match fault {
+                XrFault::SessionLoss => self.events.push_back(SessionPhase::LossPending),
+                XrFault::InstanceLoss => {
+                    let _ = self.lifecycle.on_instance_loss();
+                }
+                XrFault::RuntimeExit => self.stop(),
+                XrFault::LostCall => {
+                    self.failing = Some(XrError::session_lost);
+                }
+                XrFault::RuntimeFailure => {
+                    self.failing = Some(XrError::runtime_failure);
+                }
+            }
+        }
+    }
+
+    /// The injected failure of `call`, if the runtime is failing.
+    fn check_failing(&self, call: &'static str) -> Result<(), XrError> {
+        match self.failing {
+            Some(fail) => Err(fail(call)),
+            None => Ok(()),
+        }
+    }
+
     fn save_eyes(&mut self) -> Result<(), XrError> {
         for (eye, name) in [(0, "left"), (1, "right")] {
             let img = read_texture(&self.dev.device, &self.dev.queue, &self.textures[eye])?;
@@ -202,9 +240,12 @@ impl Headset for SimulatedHeadset {
 
     fn next_frame(&mut self) -> Result<FrameEvent, XrError> {
         let t = self.frame as f64 * self.script.period();
+        // A failing runtime fails the wait for the next frame.
+        self.check_failing("xrWaitFrame")?;
         if t >= self.script.duration {
             self.stop();
         }
+        self.inject_faults(t);
         // Poll: every pending state change, as xrPollEvent would deliver them.
         while let Some(p) = self.events.pop_front() {
             // Begin/end session, release and end-frame calls have no runtime to go to.
@@ -243,11 +284,13 @@ impl Headset for SimulatedHeadset {
     }
 
     fn acquire(&mut self) -> Result<[wgpu::TextureView; 2], XrError> {
+        self.check_failing("xrAcquireSwapchainImage")?;
         self.lifecycle.acquire_image()?;
         Ok(self.views.clone())
     }
 
     fn end_frame(&mut self, rendered: bool) -> Result<(), XrError> {
+        self.check_failing("xrEndFrame")?;
         if self.lifecycle.stage() == FrameStage::Acquired {
             self.lifecycle.release_image()?;
         }

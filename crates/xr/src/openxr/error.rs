@@ -1,6 +1,6 @@
 //! Why the XR mode could not start or went down.
 
-use super::lifecycle::FrameOrderError;
+use super::lifecycle::{ExitReason, FrameOrderError};
 use crate::error::RenderError;
 
 /// An XR failure. The first four mean "no usable OpenXR runtime here" (the app exits 2
@@ -29,7 +29,7 @@ pub enum XrError {
         detail: String,
     },
     /// An OpenXR call failed.
-    #[error("{call} failed: {result}")]
+    #[error("{call} failed: {result} ({result:?})")]
     Xr {
         /// The call.
         call: &'static str,
@@ -66,9 +66,66 @@ impl XrError {
                 | XrError::NoHeadset { .. }
         )
     }
+
+    /// `call` failed with `XR_ERROR_SESSION_LOST`.
+    pub fn session_lost(call: &'static str) -> XrError {
+        XrError::Xr {
+            call,
+            result: ::openxr::sys::Result::ERROR_SESSION_LOST,
+        }
+    }
+
+    /// `call` failed with `XR_ERROR_RUNTIME_FAILURE`.
+    pub fn runtime_failure(call: &'static str) -> XrError {
+        XrError::Xr {
+            call,
+            result: ::openxr::sys::Result::ERROR_RUNTIME_FAILURE,
+        }
+    }
+
+    /// The session's end this error means, when a call failed because the runtime lost
+    /// the session (`XR_ERROR_SESSION_LOST`) or is going away (`XR_ERROR_INSTANCE_LOST`):
+    /// the app then shuts down as on a LOSS_PENDING event instead of failing.
+    pub fn lost(&self) -> Option<ExitReason> {
+        match self {
+            XrError::Xr { result, .. } if *result == ::openxr::sys::Result::ERROR_SESSION_LOST => {
+                Some(ExitReason::SessionLost)
+            }
+            XrError::Xr { result, .. } if *result == ::openxr::sys::Result::ERROR_INSTANCE_LOST => {
+                Some(ExitReason::InstanceLost)
+            }
+            _ => None,
+        }
+    }
 }
 
 /// `map_err` helper: name the OpenXR call that failed.
 pub(crate) fn xr_call(call: &'static str) -> impl Fn(::openxr::sys::Result) -> XrError {
     move |result| XrError::Xr { call, result }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lost_session_and_instance_errors_end_the_session_others_do_not() {
+        let err = |result| XrError::Xr {
+            call: "xrWaitFrame",
+            result,
+        };
+        assert_eq!(
+            err(::openxr::sys::Result::ERROR_SESSION_LOST).lost(),
+            Some(ExitReason::SessionLost)
+        );
+        assert_eq!(
+            err(::openxr::sys::Result::ERROR_INSTANCE_LOST).lost(),
+            Some(ExitReason::InstanceLost)
+        );
+        assert_eq!(
+            err(::openxr::sys::Result::ERROR_RUNTIME_FAILURE).lost(),
+            None
+        );
+        assert_eq!(XrError::Gpu("x".into()).lost(), None);
+    }
 }
