@@ -8,6 +8,7 @@ pub mod cli;
 pub mod compare;
 pub mod exercise;
 pub mod experiment;
+pub mod interrupt;
 pub mod mesh_cmd;
 pub mod plot;
 pub mod preview;

@@ -53,6 +53,14 @@ fn default_command() -> Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let command = cli.command.unwrap_or_else(default_command);
+    // The commands that stop gracefully on Ctrl-C (outputs written, exit 130 or a clean
+    // XR session end); the others keep the default (the process dies).
+    if matches!(
+        command,
+        Command::Run { .. } | Command::Xr { .. } | Command::Exercise { .. }
+    ) {
+        incise::interrupt::install();
+    }
     let result = match command {
         Command::Run {
             scene,
@@ -238,6 +246,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<incise::interrupt::Interrupted>().is_some() => {
+            eprintln!("{e:#}");
+            ExitCode::from(incise::interrupt::EXIT_INTERRUPTED)
+        }
         Err(e) if e.downcast_ref::<incise::xr::XrUnavailable>().is_some() => {
             // No usable OpenXR runtime or headset: not a failure of incise (exit 2).
             eprintln!("{e}");

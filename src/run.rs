@@ -209,6 +209,10 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let mut failure = None;
     let dt = body.solver().params().frame_dt as f64;
     for f in 0..frames {
+        if crate::interrupt::requested() {
+            failure = Some(RunEnd::Interrupted { frames: f });
+            break;
+        }
         let t0 = Instant::now();
         if let Some((_, stroke)) = &tool {
             let time = (f + 1) as f64 * dt;
@@ -267,7 +271,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
                 });
             }
             Err(e) => {
-                failure = Some(e);
+                failure = Some(RunEnd::Failed(e.to_string()));
                 break;
             }
         }
@@ -303,37 +307,59 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     if let (Some(r), Some(path)) = (recorder, &opts.record_stroke) {
         r.finish()?.save(path)?;
     }
-    finish(report, report_path, failure.map(|e| e.to_string()), opts)
+    finish(report, report_path, failure, opts)
 }
 
-/// Record how the run ended in `report` ("completed", or "failed" with the error), write
-/// it, and return the outcome; after a failure, the error, naming the scene and saying
-/// that the output written so far is kept.
+/// Why a run stopped before its last frame.
+#[derive(Debug, Clone)]
+pub enum RunEnd {
+    /// The solver failed (the error).
+    Failed(String),
+    /// Ctrl-C or SIGTERM after this many frames.
+    Interrupted {
+        /// Frames completed.
+        frames: u64,
+    },
+}
+
+/// Record how the run ended in `report` ("completed", "failed" with the error, or
+/// "interrupted"), write it, and return the outcome; after a failure, the error naming
+/// the scene and saying that the output written so far is kept; after Ctrl-C, an
+/// [`Interrupted`](crate::interrupt::Interrupted) error (exit 130).
 pub fn finish(
     mut report: Report,
     report_path: PathBuf,
-    failure: Option<String>,
+    stopped: Option<RunEnd>,
     opts: &RunOptions,
 ) -> Result<RunOutcome> {
-    report.status = if failure.is_some() {
-        "failed"
-    } else {
-        "completed"
-    }
-    .into();
-    report.error = failure.clone();
+    let (status, error) = match &stopped {
+        None => ("completed", None),
+        Some(RunEnd::Failed(e)) => ("failed", Some(e.clone())),
+        Some(RunEnd::Interrupted { frames }) => (
+            "interrupted",
+            Some(format!("interrupted by the user after {frames} frames")),
+        ),
+    };
+    report.status = status.into();
+    report.error = error;
     report.write(&report_path)?;
-    if let Some(e) = failure {
-        bail!(
+    match stopped {
+        None => Ok(RunOutcome {
+            report_path,
+            report,
+        }),
+        Some(RunEnd::Failed(e)) => bail!(
             "{}: {e} (output so far kept in {})",
             opts.scene.display(),
             opts.out.display()
-        );
+        ),
+        Some(RunEnd::Interrupted { frames }) => Err(crate::interrupt::Interrupted {
+            what: opts.scene.display().to_string(),
+            frames,
+            out: opts.out.display().to_string(),
+        }
+        .into()),
     }
-    Ok(RunOutcome {
-        report_path,
-        report,
-    })
 }
 
 /// Write `snap_NNNNN.vtu` for frame `frame` and add it to the collection.

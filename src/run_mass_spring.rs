@@ -147,9 +147,23 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
     report.mesh.tets = after.tets;
     report.mesh.skin_vertices = after.nodes;
     report.mesh.skin_triangles = after.triangles;
-    report.status = "completed".into();
+    let interrupted = crate::interrupt::requested();
+    report.status = if interrupted {
+        "interrupted"
+    } else {
+        "completed"
+    }
+    .into();
     let report_path = opts.out.join("report.json");
     report.write(&report_path)?;
+    if interrupted {
+        return Err(crate::interrupt::Interrupted {
+            what: opts.scene.display().to_string(),
+            frames: report.frames.len() as u64,
+            out: opts.out.display().to_string(),
+        }
+        .into());
+    }
     if !opts.quiet {
         eprintln!(
             "mass-spring: {} nodes, {} tets, {} edges after {} frames",
@@ -177,6 +191,9 @@ fn run_frames(
     let mut cutter = Cutter::new(ms.cut.clone());
     let mut cutting = false;
     for f in 0..frames {
+        if crate::interrupt::requested() {
+            break;
+        }
         let t0 = Instant::now();
         if let Some(stroke) = &ms.stroke {
             let (pose, progress) = blade_at(stroke, model.time());
@@ -246,6 +263,9 @@ fn run_haptic(
     haptic.set_tool(Some(tool(blade_at(stroke, 0.0).0)));
     let (mut previous_loops, mut max_force, mut blade_down) = (0u64, 0.0f64, false);
     for f in 0..frames {
+        if crate::interrupt::requested() {
+            break;
+        }
         let deadline = start + std::time::Duration::from_secs_f64((f + 1) as f64 * frame_dt);
         let now = Instant::now();
         if now < deadline {

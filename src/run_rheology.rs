@@ -4,6 +4,7 @@
 //! dent of the probe node under the indenter and the materials per region), VTU snapshots
 //! and a ParaView collection.
 
+use crate::run::RunEnd;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -185,11 +186,15 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
     let mut failure = None;
     let (mut max_dent, mut dent) = (0.0f64, 0.0f64);
     for f in 0..frames {
+        if crate::interrupt::requested() {
+            failure = Some(RunEnd::Interrupted { frames: f });
+            break;
+        }
         let t0 = Instant::now();
         let steps = match body.advance(frame_dt) {
             Ok(n) => n,
             Err(e) => {
-                failure = Some(e);
+                failure = Some(RunEnd::Failed(e.to_string()));
                 break;
             }
         };
@@ -227,7 +232,7 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
         info.max_dent_m = max_dent;
         info.residual_dent_m = dent;
     }
-    crate::run::finish(report, report_path, failure.map(|e| e.to_string()), opts)
+    crate::run::finish(report, report_path, failure, opts)
 }
 
 /// Tet and edge counts per material (index 0: the default, k: region k − 1).

@@ -1,6 +1,7 @@
 //! Issue 11, fault survival from the command line: a GPU lost mid-run hands over to the
 //! CPU with a warning in report.json; a NaN in the solver stops the run with the frame
-//! and tet named, the frame rolled back and the output so far kept.
+//! and tet named, the frame rolled back and the output so far kept; Ctrl-C stops a run
+//! (exit 130) or an XR session (clean end) with the outputs written.
 
 mod common;
 
@@ -85,4 +86,98 @@ fn a_nan_stops_the_run_naming_frame_and_tet_and_keeps_the_output() {
             "{device}: snapshots kept"
         );
     }
+}
+
+/// Send SIGINT (Ctrl-C) to `child`.
+fn ctrl_c(child: &std::process::Child) {
+    let ok = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs")
+        .success();
+    assert!(ok, "kill -INT failed");
+}
+
+/// Ctrl-C stops `incise run` after the frame in hand: exit 130, report.json with status
+/// "interrupted" and the frames done, the stroke recorded so far saved in full.
+#[test]
+fn ctrl_c_stops_a_run_keeping_its_report_and_stroke() {
+    let dir = temp_dir("ctrl-c-run");
+    let out = dir.join("out");
+    let stroke = dir.join("stroke.ron");
+    let child = common::incise_command(&[
+        "run",
+        "config/plate_cut.ron",
+        "--device",
+        "cpu",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--record-stroke",
+        stroke.to_str().unwrap(),
+    ])
+    .stderr(std::process::Stdio::piped())
+    .spawn()
+    .expect("incise starts");
+    // The first checkpoint (frame 60 of 192) is written: the run is under way.
+    let started = std::time::Instant::now();
+    while !out.join("report.json").exists() {
+        assert!(started.elapsed().as_secs() < 300, "no checkpoint in 5 min");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    ctrl_c(&child);
+    let o = child.wait_with_output().unwrap();
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted after"), "{err}");
+    let r = report(&out);
+    assert_eq!(r["status"], "interrupted", "{r}");
+    let frames = r["frames"].as_array().unwrap().len();
+    assert!((60..192).contains(&frames), "{frames} frames");
+    let s = incise_scalpel::load_stroke(&stroke).unwrap();
+    let dt = 1.0 / 60.0;
+    assert!(
+        (s.end_time() - frames as f64 * dt).abs() < 1.5 * dt,
+        "the stroke covers the frames run: {} s for {frames} frames",
+        s.end_time()
+    );
+}
+
+/// Ctrl-C during `incise xr` ends the session through the runtime's shutdown
+/// (xrRequestExitSession): exit 0, the report and frame log written.
+#[test]
+fn ctrl_c_ends_an_xr_session_cleanly() {
+    let dir = temp_dir("ctrl-c-xr");
+    let script = dir.join("headset.ron");
+    // Long enough (60 s of display time) never to finish on its own before the signal.
+    std::fs::write(
+        &script,
+        "(duration: 60.0, eye_size: (64, 64), render_every: 30, \
+         head: [(t: 0.0, position: (0.0, 1.25, -0.05), orientation: (-0.34202, 0.0, 0.0, 0.93969))])",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let child = common::incise_command(&[
+        "xr",
+        "config/plate_cut.ron",
+        "--simulated-headset",
+        script.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+    .stderr(std::process::Stdio::piped())
+    .spawn()
+    .expect("incise starts");
+    std::thread::sleep(std::time::Duration::from_secs(5));
+    ctrl_c(&child);
+    let o = child.wait_with_output().unwrap();
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("xr_report.json")).unwrap())
+            .unwrap();
+    assert_eq!(r["exit"], "Exited", "{r}");
+    let frames = r["frames"].as_u64().unwrap();
+    assert!(frames < 60 * 72, "stopped early: {frames} frames");
+    assert!(out.join("frames.csv").exists());
 }

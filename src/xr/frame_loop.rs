@@ -265,7 +265,12 @@ pub fn run_loop(
                 haptic: sent,
             });
             out.frames += 1;
-            if !exit_asked && opts.max_frames.is_some_and(|m| out.frames >= m) {
+            // Ctrl-C ends the session the way the runtime expects (xrRequestExitSession),
+            // so the stroke and report are saved as after any other end.
+            if !exit_asked
+                && (opts.max_frames.is_some_and(|m| out.frames >= m)
+                    || crate::interrupt::requested())
+            {
                 exit_asked = true;
                 headset.request_exit()?;
             }
