@@ -372,3 +372,47 @@ fn shipped_exercises_all_load() {
     }
     assert!(n >= 3, "only {n} exercises ship");
 }
+
+/// The shipped reference strokes (`config/strokes/`, what a good attempt looks like) pass
+/// their own exercises, and `--reference-stroke` still writes exactly them.
+fn reference_passes(name: &str) {
+    let dir = temp_dir(&format!("exercise-reference-{name}"));
+    let exercise = format!("config/exercises/{name}.ron");
+    let shipped = format!("config/strokes/{name}_reference.ron");
+    let written = dir.join("reference.ron");
+    let o = incise(&[
+        "exercise",
+        &exercise,
+        "--reference-stroke",
+        written.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(
+        std::fs::read_to_string(&written).unwrap(),
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(&shipped)).unwrap(),
+        "{shipped} is out of date: regenerate it with `incise exercise {exercise} --reference-stroke {shipped}`"
+    );
+    let r = attempt(
+        &dir,
+        name,
+        &exercise,
+        &incise_scalpel::load_stroke(&written).unwrap(),
+    );
+    assert_eq!(r["verdict"]["passed"], true, "{name}: {}", r["verdict"]);
+    assert!(
+        r["metrics"]["completion"].as_f64().unwrap() > 0.95,
+        "{name}"
+    );
+}
+
+#[test]
+fn slab_reference_strokes_pass_their_exercises() {
+    reference_passes("slab_depth");
+    reference_passes("slab_arc");
+}
+
+/// 193 frames of the 34k-tet bowel at 125 substeps: about 1.5 min of CPU.
+#[test]
+fn intestine_reference_stroke_passes_its_exercise() {
+    reference_passes("intestine_enterotomy");
+}
