@@ -22,6 +22,7 @@ pub mod lifecycle;
 pub mod pacing;
 pub mod passthrough;
 pub mod pose;
+pub mod result_panel;
 pub mod runtime;
 pub mod scalpel_pose;
 pub mod session;
