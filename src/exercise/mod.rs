@@ -4,6 +4,7 @@
 //! local history of attempts. Definitions: docs/scoring.md.
 
 mod attempt;
+mod decal;
 mod history;
 mod load;
 mod metrics;
@@ -14,6 +15,7 @@ mod report_html;
 mod score;
 
 pub use attempt::{Attempt, ExerciseOptions, ExerciseResult, run_exercise};
+pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, DecalPoints, PlanDecal};
 pub use history::{
     HistoryEntry, append as append_history, read as read_history, table as history_table,
 };
