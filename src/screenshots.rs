@@ -12,7 +12,7 @@ use incise_sim::skin::Skin;
 use incise_sim::{Solver, TetMesh};
 use incise_xr::frame::pinned_nodes;
 use incise_xr::{
-    BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, View,
+    BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View,
 };
 
 use crate::body::{Body, DeviceChoice};
@@ -158,6 +158,13 @@ impl Screenshots {
 
     /// Render `body` now and write the PNG to `path`.
     pub fn save(&mut self, body: &Body, path: &Path) -> Result<()> {
+        self.image(body)?
+            .save_png(path)
+            .with_context(|| format!("writing screenshot {}", path.display()))
+    }
+
+    /// Render `body` now.
+    pub fn image(&mut self, body: &Body) -> Result<RgbaImage> {
         let solver = body.solver();
         if self.draw_tool {
             self.settings.tool = crate::tool_view::tool_state(solver);
@@ -166,11 +173,9 @@ impl Screenshots {
         if let (Body::Gpu(g), true) = (body, self.shared_device) {
             state.device_positions = Some(g.position_buffer());
         }
-        let img = self
+        Ok(self
             .offscreen
-            .render_image(&state, &self.settings, &self.view)?;
-        img.save_png(path)
-            .with_context(|| format!("writing screenshot {}", path.display()))
+            .render_image(&state, &self.settings, &self.view)?)
     }
 }
 
