@@ -84,7 +84,8 @@ fn cut_material() -> Material {
     return Material(vec3<f32>(0.50, 0.055, 0.06), 0.16, 0.035, 0.35, vec3<f32>(0.85, 0.12, 0.10));
 }
 
-// Material-id colours (id mode): what tests count on screen.
+// Material-id colours (id mode): what tests count on screen. Linear values of the sRGB
+// bytes in MATERIAL_IDS (crates/xr/src/frame.rs): 0.2158605 encodes as 128.
 const ID_SKIN: vec3<f32> = vec3<f32>(0.0, 1.0, 0.0);
 const ID_SKIN_BACK: vec3<f32> = vec3<f32>(0.0, 0.0, 1.0);
 const ID_CUT: vec3<f32> = vec3<f32>(1.0, 0.0, 0.0);
@@ -92,3 +93,4 @@ const ID_STRESS: vec3<f32> = vec3<f32>(1.0, 1.0, 0.0);
 const ID_TOOL: vec3<f32> = vec3<f32>(1.0, 0.0, 1.0);
 const ID_MARKER: vec3<f32> = vec3<f32>(0.0, 1.0, 1.0);
 const ID_LINE: vec3<f32> = vec3<f32>(1.0, 1.0, 1.0);
+const ID_PLAN: vec3<f32> = vec3<f32>(1.0, 0.2158605, 0.0);

@@ -66,12 +66,13 @@ pub enum ShadingMode {
     #[default]
     Lit,
     /// Flat colours per material (skin, skin back, cut surface, stress, tool, markers,
-    /// lines; see [`MATERIAL_IDS`]), for tests and picking.
+    /// wireframe lines, surface lines; see [`MATERIAL_IDS`]), for tests and picking.
     MaterialIds,
 }
 
-/// The flat colours of [`ShadingMode::MaterialIds`], by material name.
-pub const MATERIAL_IDS: [(&str, [u8; 3]); 7] = [
+/// The flat colours of [`ShadingMode::MaterialIds`], by material name, as the bytes of an
+/// sRGB image (the `ID_*` constants of `shaders/render_common.wgsl` are their linear values).
+pub const MATERIAL_IDS: [(&str, [u8; 3]); 8] = [
     ("skin", [0, 255, 0]),
     ("skin_back", [0, 0, 255]),
     ("cut", [255, 0, 0]),
@@ -79,7 +80,21 @@ pub const MATERIAL_IDS: [(&str, [u8; 3]); 7] = [
     ("tool", [255, 0, 255]),
     ("marker", [0, 255, 255]),
     ("line", [255, 255, 255]),
+    ("plan", [255, 128, 0]),
 ];
+
+/// A line drawn on the tissue surface, e.g. a planned incision (deformed positions).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceLine {
+    /// Points along the line, world m.
+    pub points: Vec<Vec3>,
+    /// Outward surface normal at each point (same length as `points`).
+    pub normals: Vec<Vec3>,
+    /// Width of the drawn band, m.
+    pub width: f32,
+    /// Colour, linear RGB.
+    pub colour: [f32; 3],
+}
 
 /// The scalpel (or stand-in) as drawn.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -109,6 +124,8 @@ pub struct RenderSettings {
     pub background_alpha: f64,
     /// Exposure applied before tone mapping.
     pub exposure: f32,
+    /// Lines drawn on the tissue surface.
+    pub lines: Vec<SurfaceLine>,
 }
 
 impl Default for RenderSettings {
@@ -121,6 +138,7 @@ impl Default for RenderSettings {
             background: [0.020, 0.024, 0.032],
             background_alpha: 1.0,
             exposure: 1.0,
+            lines: Vec::new(),
         }
     }
 }

@@ -5,7 +5,8 @@
 //! windows, headsets or the command line. Per frame it deforms the skin on the GPU from
 //! its tet embedding, hides skin triangles of released tets, draws the cut surface in a
 //! wet-tissue material, and adds the switchable overlays (von Mises heat map, tet
-//! wireframe, tool spheres, pinned nodes) and the tool mesh, with 4× MSAA into sRGB.
+//! wireframe, tool spheres, pinned nodes), the tool mesh and lines drawn on the tissue
+//! surface (planned incisions), with 4× MSAA into sRGB.
 
 pub mod camera;
 pub mod colour_map;
@@ -19,6 +20,7 @@ pub mod offscreen;
 pub mod openxr;
 mod pipelines;
 pub mod renderer;
+mod ribbon;
 mod scene_buffers;
 pub mod shaders;
 mod targets;
@@ -27,7 +29,7 @@ pub mod tool_mesh;
 pub use camera::{Camera, View};
 pub use device::RenderDevice;
 pub use error::RenderError;
-pub use frame::{BodyState, Overlays, RenderSettings, ShadingMode, ToolState};
+pub use frame::{BodyState, Overlays, RenderSettings, ShadingMode, SurfaceLine, ToolState};
 pub use image_io::RgbaImage;
 pub use offscreen::OffscreenRenderer;
 pub use renderer::Renderer;

@@ -16,6 +16,7 @@ pub(crate) struct Pipelines {
     pub wireframe: wgpu::RenderPipeline,
     pub markers: wgpu::RenderPipeline,
     pub tool: wgpu::RenderPipeline,
+    pub surface_line: wgpu::RenderPipeline,
 }
 
 const VEC4: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x4];
@@ -25,9 +26,12 @@ const INSTANCE: [wgpu::VertexAttribute; 2] =
     wgpu::vertex_attr_array![1 => Float32x4, 2 => Float32x4];
 const POS_NORMAL: [wgpu::VertexAttribute; 2] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+const POS_NORMAL_COLOUR: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
 
 /// How one pipeline differs from the others.
 struct Spec<'a> {
+    layout: &'a wgpu::PipelineLayout,
     shader: &'a str,
     vs: &'a str,
     fs: &'a str,
@@ -52,7 +56,7 @@ impl Pipelines {
             let module = shaders::module(device, s.shader);
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(s.shader),
-                layout: Some(&pipeline_layout),
+                layout: Some(s.layout),
                 vertex: wgpu::VertexState {
                     module: &module,
                     entry_point: Some(s.vs),
@@ -91,6 +95,7 @@ impl Pipelines {
             })
         };
         let solid = (true, wgpu::CompareFunction::Less);
+        let l = &pipeline_layout;
         let tris = wgpu::PrimitiveTopology::TriangleList;
         let vec4 = |attributes| wgpu::VertexBufferLayout {
             array_stride: 16,
@@ -99,6 +104,7 @@ impl Pipelines {
         };
         Pipelines {
             skin: make(Spec {
+                layout: l,
                 shader: "skin",
                 vs: "vs",
                 fs: "fs",
@@ -108,6 +114,7 @@ impl Pipelines {
                 blend: None,
             }),
             cut: make(Spec {
+                layout: l,
                 shader: "tet_faces",
                 vs: "vs_cut",
                 fs: "fs_cut",
@@ -117,6 +124,7 @@ impl Pipelines {
                 blend: None,
             }),
             stress: make(Spec {
+                layout: l,
                 shader: "tet_faces",
                 vs: "vs_surface",
                 fs: "fs_stress",
@@ -127,6 +135,7 @@ impl Pipelines {
             }),
             // X-ray: every live edge, over the surfaces, half transparent.
             wireframe: make(Spec {
+                layout: l,
                 shader: "wireframe",
                 vs: "vs",
                 fs: "fs",
@@ -136,6 +145,7 @@ impl Pipelines {
                 blend: Some(wgpu::BlendState::ALPHA_BLENDING),
             }),
             markers: make(Spec {
+                layout: l,
                 shader: "markers",
                 vs: "vs",
                 fs: "fs",
@@ -156,6 +166,7 @@ impl Pipelines {
                 blend: None,
             }),
             tool: make(Spec {
+                layout: l,
                 shader: "tool",
                 vs: "vs",
                 fs: "fs",
@@ -163,6 +174,21 @@ impl Pipelines {
                     array_stride: 24,
                     step_mode: wgpu::VertexStepMode::Vertex,
                     attributes: &POS_NORMAL,
+                })],
+                topology: tris,
+                depth: solid,
+                blend: None,
+            }),
+            // Opaque ribbons lifted off the skin (ribbon.rs), hidden where tissue is nearer.
+            surface_line: make(Spec {
+                layout: l,
+                shader: "surface_line",
+                vs: "vs",
+                fs: "fs",
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 36,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &POS_NORMAL_COLOUR,
                 })],
                 topology: tris,
                 depth: solid,

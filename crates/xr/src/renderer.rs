@@ -77,7 +77,8 @@ struct Timer {
     period_ns: f32,
 }
 
-/// Draws one body (tet mesh + skin) with its cut surface, overlays and tool.
+/// Draws one body (tet mesh + skin) with its cut surface, overlays, tool and surface
+/// lines.
 pub struct Renderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -317,6 +318,11 @@ impl Renderer {
             pass.set_vertex_buffer(1, sc.markers.buffer.slice(..));
             pass.set_index_buffer(self.sphere.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..self.sphere.index_count, 0, 0..sc.markers.len);
+        }
+        if sc.lines.len > 0 {
+            pass.set_pipeline(&self.pipelines.surface_line);
+            pass.set_vertex_buffer(0, sc.lines.buffer.slice(..));
+            pass.draw(0..sc.lines.len, 0..1);
         }
         if s.overlays.wireframe && sc.edges.len > 0 {
             pass.set_pipeline(&self.pipelines.wireframe);

@@ -1,7 +1,8 @@
 //! Device copies of what changes with the body: node positions, stress, the visible skin
-//! triangles, cut and surface faces, wireframe edges and marker instances, with the bind
-//! group the render pipelines share. Lists that depend on the cut are rebuilt only when
-//! tets were released since the last frame.
+//! triangles, cut and surface faces, wireframe edges, marker instances and surface-line
+//! ribbons, with the bind group the render pipelines share. Lists that depend on the cut
+//! are rebuilt only when tets were released since the last frame; markers and ribbons
+//! are rebuilt every frame.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -10,6 +11,7 @@ use incise_sim::mesh::{NO_NEIGHBOR, TET_EDGES, TET_FACES};
 use incise_sim::skin::Skin;
 
 use crate::frame::{BodyState, RenderSettings};
+use crate::ribbon::{self, LineVertex};
 
 /// Bytes between the per-view globals (the uniform-offset alignment every adapter accepts).
 pub(crate) const GLOBALS_STRIDE: u64 = 256;
@@ -105,6 +107,8 @@ pub(crate) struct SceneBuffers {
     pub edges: GrowBuffer,
     pub skin_index: GrowBuffer,
     pub markers: GrowBuffer,
+    /// Surface-line ribbon vertices (a triangle list).
+    pub lines: GrowBuffer,
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
     tets: Vec<[u32; 4]>,
@@ -119,6 +123,7 @@ pub(crate) struct SceneBuffers {
     /// Released-tet count the wireframe edges were built for.
     edges_built_for: Option<usize>,
     host_nodes: Vec<[f32; 4]>,
+    host_lines: Vec<LineVertex>,
 }
 
 impl SceneBuffers {
@@ -144,6 +149,7 @@ impl SceneBuffers {
             skin.surface.triangles.len() as u64 * 12,
         );
         let markers = GrowBuffer::new(device, "markers", U::VERTEX, 64 * 32);
+        let lines = GrowBuffer::new(device, "surface lines", U::VERTEX, 0);
         let entry = |binding: u32, ty: wgpu::BindingType, vis: wgpu::ShaderStages| {
             wgpu::BindGroupLayoutEntry {
                 binding,
@@ -208,6 +214,7 @@ impl SceneBuffers {
             edges,
             skin_index,
             markers,
+            lines,
             layout,
             bind_group,
             tets: mesh.tets.clone(),
@@ -219,6 +226,7 @@ impl SceneBuffers {
             faces_built_for: None,
             edges_built_for: None,
             host_nodes: Vec::new(),
+            host_lines: Vec::new(),
         }
     }
 
@@ -302,6 +310,9 @@ impl SceneBuffers {
             self.edges_built_for = Some(released);
         }
         self.update_markers(device, queue, state, settings);
+        self.host_lines.clear();
+        ribbon::build(&settings.lines, &mut self.host_lines);
+        self.lines.write(device, queue, &self.host_lines);
         if grown {
             self.bind_group = Self::bind(
                 device,

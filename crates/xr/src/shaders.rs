@@ -4,7 +4,14 @@
 const COMMON: &str = include_str!("../../../shaders/render_common.wgsl");
 
 /// Render shaders (each `shaders/<name>.wgsl`, with the common part prepended).
-pub const RENDER_SHADERS: [&str; 5] = ["skin", "tet_faces", "wireframe", "markers", "tool"];
+pub const RENDER_SHADERS: [&str; 6] = [
+    "skin",
+    "tet_faces",
+    "wireframe",
+    "markers",
+    "tool",
+    "surface_line",
+];
 
 /// Compute shaders of the skin deformation (each `shaders/<name>.wgsl`).
 pub const COMPUTE_SHADERS: [&str; 2] = ["skin_deform", "skin_normals"];
@@ -18,6 +25,7 @@ pub fn source(name: &str) -> Option<String> {
         "wireframe" => render(include_str!("../../../shaders/wireframe.wgsl")),
         "markers" => render(include_str!("../../../shaders/markers.wgsl")),
         "tool" => render(include_str!("../../../shaders/tool.wgsl")),
+        "surface_line" => render(include_str!("../../../shaders/surface_line.wgsl")),
         "skin_deform" => include_str!("../../../shaders/skin_deform.wgsl").to_string(),
         "skin_normals" => include_str!("../../../shaders/skin_normals.wgsl").to_string(),
         _ => return None,
@@ -52,5 +60,30 @@ mod tests {
             .unwrap_or_else(|e| panic!("{name}.wgsl: {}", e.emit_to_string(&src)));
         }
         assert!(source("nonexistent").is_none());
+    }
+
+    /// The shaders' `ID_*` constants are the linear values of the sRGB bytes that
+    /// `MATERIAL_IDS` promises (what tests look for in id-mode images).
+    #[test]
+    fn id_colours_in_the_shaders_encode_to_the_material_id_bytes() {
+        let encode = |c: f32| {
+            let s = if c <= 0.003_130_8 {
+                12.92 * c
+            } else {
+                1.055 * c.powf(1.0 / 2.4) - 0.055
+            };
+            (s * 255.0).round() as u8
+        };
+        for (name, bytes) in crate::frame::MATERIAL_IDS {
+            let decl = format!("const ID_{}: vec3<f32> = vec3<f32>(", name.to_uppercase());
+            let start = COMMON
+                .find(&decl)
+                .unwrap_or_else(|| panic!("render_common.wgsl has no `{decl}`"))
+                + decl.len();
+            let args = &COMMON[start..start + COMMON[start..].find(')').unwrap()];
+            let linear: Vec<f32> = args.split(',').map(|v| v.trim().parse().unwrap()).collect();
+            let encoded: Vec<u8> = linear.iter().map(|&c| encode(c)).collect();
+            assert_eq!(encoded, bytes, "ID_{} = {linear:?}", name.to_uppercase());
+        }
     }
 }
