@@ -85,6 +85,7 @@ fn main() -> ExitCode {
             record_stroke,
             inject_gpu_loss_at,
             inject_nan_at,
+            screenshot_decal: None,
         })
         .map(|o| {
             println!("{}", o.report.summary());

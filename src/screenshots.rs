@@ -16,6 +16,7 @@ use incise_xr::{
 };
 
 use crate::body::{Body, DeviceChoice};
+use crate::exercise::PlanDecal;
 
 /// An image size `WIDTHxHEIGHT` given on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -105,6 +106,8 @@ pub struct Screenshots {
     shared_device: bool,
     /// Whether the solver's tool is drawn (its mesh given by [`Screenshots::with_tool`]).
     draw_tool: bool,
+    /// A planned incision drawn on the tissue (where it is not cut away).
+    decal: Option<PlanDecal>,
 }
 
 impl Screenshots {
@@ -137,6 +140,7 @@ impl Screenshots {
             pinned: pinned_nodes(solver),
             shared_device: false,
             draw_tool: false,
+            decal: None,
         })
     }
 
@@ -147,6 +151,12 @@ impl Screenshots {
             .renderer
             .set_tool_mesh(&crate::tool_view::tool_mesh(tool));
         self.draw_tool = true;
+        self
+    }
+
+    /// Draw `decal` (an exercise's plan) on the tissue, following its deformation.
+    pub fn with_decal(mut self, decal: PlanDecal) -> Self {
+        self.decal = Some(decal);
         self
     }
 
@@ -169,6 +179,11 @@ impl Screenshots {
         if self.draw_tool {
             self.settings.tool = crate::tool_view::tool_state(solver);
         }
+        self.settings.lines = self
+            .decal
+            .iter()
+            .map(|d| d.line_uncut(solver.positions(), solver.cut().live()))
+            .collect();
         let mut state = BodyState::of_solver(solver, &self.pinned);
         if let (Body::Gpu(g), true) = (body, self.shared_device) {
             state.device_positions = Some(g.position_buffer());

@@ -39,7 +39,7 @@ fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
         ImageSize(480, 270),
         Default::default(),
     )
-    .map(|s| s.with_tool(&hand.tool))
+    .map(|s| s.with_tool(&hand.tool).with_decal(mode.decal.clone()))
     .map_err(|e| format!("{e:#}"));
     let rendered = pictures.is_ok();
     let mut body = Body::Cpu(Box::new(built.solver));

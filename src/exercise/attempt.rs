@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use incise_sim::xpbd::FrameStats;
 use serde::Serialize;
 
+use super::decal::PlanDecal;
 use super::history::{self, HistoryEntry};
 use super::load::{LoadedExercise, load_exercise};
 use super::metrics::{self, Metrics};
@@ -113,6 +114,7 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
         record_stroke: None,
         inject_gpu_loss_at: None,
         inject_nan_at: None,
+        screenshot_decal: Some(PlanDecal::new(&ex.plan, &ex.mesh)),
     })
     .with_context(|| format!("{}: running the attempt", opts.exercise.display()))?;
     let report = outcome.report;

@@ -6,6 +6,7 @@
 use glam::{Mat3, Vec3};
 use incise_sim::TetMesh;
 use incise_sim::mesh::{closest_point_on_triangle, shape_matrix};
+use incise_xr::SurfaceLine;
 
 use super::plan::Plan;
 
@@ -31,6 +32,8 @@ const INSIDE_EPS: f32 = 1e-5;
 /// normal with the tet's deformation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Anchor {
+    /// The tet.
+    tet: u32,
     /// The tet's four nodes.
     nodes: [u32; 4],
     /// Barycentric weights of the point in the tet (sum 1; slightly outside 0..1 when the
@@ -49,15 +52,6 @@ pub struct PlanDecal {
     anchors: Vec<Anchor>,
     /// Points that lay outside every tet and were embedded in the nearest boundary tet.
     pub outside: usize,
-}
-
-/// Points and normals of the decal for one state of the body.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct DecalPoints {
-    /// Points along the plan, m.
-    pub points: Vec<Vec3>,
-    /// Unit outward normals there.
-    pub normals: Vec<Vec3>,
 }
 
 impl PlanDecal {
@@ -85,6 +79,7 @@ impl PlanDecal {
                 outside += usize::from(!inside);
                 let nodes = mesh.tets[tet];
                 Anchor {
+                    tet: tet as u32,
                     nodes,
                     bary: barycentric(mesh, tet, p),
                     dm_inv: mesh.dm_inv[tet],
@@ -105,36 +100,61 @@ impl PlanDecal {
         self.anchors.is_empty()
     }
 
-    /// The decal on a body whose nodes are at `positions`: each point is its tet's nodes
-    /// weighted by its barycentric coordinates, each normal the rest normal mapped by the
-    /// tet's deformation gradient `F` as `F⁻ᵀ n` (computed as cof(F)·n with the sign of
-    /// det F), normalised. Points whose tet names a node past the end of `positions`, or
-    /// that come out non-finite, are left out; a degenerate tet keeps the rest normal.
-    pub fn deform(&self, positions: &[Vec3]) -> DecalPoints {
-        let mut out = DecalPoints {
+    /// The decal on a body whose nodes are at `positions`, [`DECAL_WIDTH`] wide in
+    /// [`DECAL_COLOUR`]: each point is its tet's nodes weighted by its barycentric
+    /// coordinates, each normal the rest normal mapped by the tet's deformation gradient
+    /// `F` as `F⁻ᵀ n` (computed as cof(F)·n with the sign of det F), normalised; a
+    /// degenerate tet keeps the rest normal. One entry per drawn point, in order: a point
+    /// whose tet names a node past the end of `positions`, or that comes out non-finite,
+    /// is a gap (a NaN point with a zero normal), where the renderer splits the line.
+    pub fn line(&self, positions: &[Vec3]) -> SurfaceLine {
+        self.build(positions, |_| true)
+    }
+
+    /// [`PlanDecal::line`] with a gap wherever the point's tet was cut away
+    /// (`live[t]` false): the ink goes with the tissue, and what is left of the line is
+    /// the part of the plan not cut yet. Tets past the end of `live` count as live.
+    pub fn line_uncut(&self, positions: &[Vec3], live: &[bool]) -> SurfaceLine {
+        self.build(positions, |t| live.get(t).copied().unwrap_or(true))
+    }
+
+    fn build(&self, positions: &[Vec3], keep: impl Fn(usize) -> bool) -> SurfaceLine {
+        let mut out = SurfaceLine {
             points: Vec::with_capacity(self.anchors.len()),
             normals: Vec::with_capacity(self.anchors.len()),
+            width: DECAL_WIDTH,
+            colour: DECAL_COLOUR,
         };
         for a in &self.anchors {
-            if a.nodes.iter().any(|&i| i as usize >= positions.len()) {
-                continue;
-            }
-            let x = a.nodes.map(|i| positions[i as usize]);
-            let p: Vec3 = (0..4).map(|c| a.bary[c] * x[c]).sum();
-            let f = shape_matrix(x[0], x[1], x[2], x[3]) * a.dm_inv;
-            let cof = Mat3::from_cols(
-                f.y_axis.cross(f.z_axis),
-                f.z_axis.cross(f.x_axis),
-                f.x_axis.cross(f.y_axis),
-            );
-            let m = cof * a.normal * f.determinant().signum();
-            let n = m.try_normalize().unwrap_or(a.normal);
-            if p.is_finite() && n.is_finite() {
-                out.points.push(p);
-                out.normals.push(n);
-            }
+            let (p, n) = match a.deformed(positions) {
+                Some(pn) if keep(a.tet as usize) => pn,
+                _ => (Vec3::NAN, Vec3::ZERO),
+            };
+            out.points.push(p);
+            out.normals.push(n);
         }
         out
+    }
+}
+
+impl Anchor {
+    /// Position and unit normal for node positions `positions`; `None` when a node is
+    /// missing or the result is not finite.
+    fn deformed(&self, positions: &[Vec3]) -> Option<(Vec3, Vec3)> {
+        if self.nodes.iter().any(|&i| i as usize >= positions.len()) {
+            return None;
+        }
+        let x = self.nodes.map(|i| positions[i as usize]);
+        let p: Vec3 = (0..4).map(|c| self.bary[c] * x[c]).sum();
+        let f = shape_matrix(x[0], x[1], x[2], x[3]) * self.dm_inv;
+        let cof = Mat3::from_cols(
+            f.y_axis.cross(f.z_axis),
+            f.z_axis.cross(f.x_axis),
+            f.x_axis.cross(f.y_axis),
+        );
+        let m = cof * self.normal * f.determinant().signum();
+        let n = m.try_normalize().unwrap_or(self.normal);
+        (p.is_finite() && n.is_finite()).then_some((p, n))
     }
 }
 
@@ -214,7 +234,7 @@ mod tests {
         let (mesh, plan) = slab_and_plan();
         let decal = PlanDecal::new(&plan, &mesh);
         assert_eq!(decal.outside, 0);
-        let line = decal.deform(&mesh.rest_positions);
+        let line = decal.line(&mesh.rest_positions);
         assert_eq!(line.points.len(), decal.len());
         // The first and last samples, the rest about 1 mm apart.
         let first = plan.samples[0].point.as_vec3();
@@ -241,7 +261,7 @@ mod tests {
     fn an_affine_deformation_moves_points_and_normals_exactly() {
         let (mesh, plan) = slab_and_plan();
         let decal = PlanDecal::new(&plan, &mesh);
-        let rest = decal.deform(&mesh.rest_positions);
+        let rest = decal.line(&mesh.rest_positions);
         // Stretch, shear and a rotation, then a shift: x ↦ A x + b.
         let a = Mat3::from_rotation_z(0.4)
             * Mat3::from_cols(
@@ -251,7 +271,7 @@ mod tests {
             );
         let b = Vec3::new(0.01, -0.02, 0.005);
         let moved: Vec<Vec3> = mesh.rest_positions.iter().map(|&x| a * x + b).collect();
-        let line = decal.deform(&moved);
+        let line = decal.line(&moved);
         assert_eq!(line.points.len(), rest.points.len());
         let cof = a.inverse().transpose();
         for i in 0..line.points.len() {
@@ -294,13 +314,47 @@ mod tests {
         );
     }
 
+    /// Whether entry `i` of `line` is a gap (where the renderer splits the line).
+    fn gap(line: &SurfaceLine, i: usize) -> bool {
+        !line.points[i].is_finite() && line.normals[i] == Vec3::ZERO
+    }
+
     #[test]
-    fn short_or_broken_positions_leave_points_out_without_panicking() {
+    fn short_or_broken_positions_are_gaps_without_panicking() {
         let (mesh, plan) = slab_and_plan();
         let decal = PlanDecal::new(&plan, &mesh);
-        assert!(decal.deform(&[]).points.is_empty());
-        let mut nan = mesh.rest_positions.clone();
-        nan.iter_mut().for_each(|x| *x = Vec3::NAN);
-        assert!(decal.deform(&nan).points.is_empty());
+        let short = decal.line(&[]);
+        assert_eq!(short.points.len(), decal.len());
+        assert!((0..decal.len()).all(|i| gap(&short, i)));
+        let nan = vec![Vec3::NAN; mesh.node_count()];
+        let broken = decal.line(&nan);
+        assert!((0..decal.len()).all(|i| gap(&broken, i)));
+        let rest = decal.line(&mesh.rest_positions);
+        assert!((0..decal.len()).all(|i| !gap(&rest, i)));
+    }
+
+    #[test]
+    fn tets_cut_away_take_their_part_of_the_line() {
+        let (mesh, plan) = slab_and_plan();
+        let decal = PlanDecal::new(&plan, &mesh);
+        // Cut away the tets under the middle third of the line.
+        let n = decal.len();
+        let mut live = vec![true; mesh.tet_count()];
+        for a in &decal.anchors[n / 3..2 * n / 3] {
+            live[a.tet as usize] = false;
+        }
+        let line = decal.line_uncut(&mesh.rest_positions, &live);
+        assert_eq!(line.points.len(), n);
+        for i in 0..n {
+            let cut = !live[decal.anchors[i].tet as usize];
+            assert_eq!(gap(&line, i), cut, "point {i}");
+        }
+        assert!((n / 3..2 * n / 3).all(|i| gap(&line, i)));
+        assert!(!gap(&line, 0) && !gap(&line, n - 1));
+        // Nothing cut: the whole line.
+        assert_eq!(
+            decal.line_uncut(&mesh.rest_positions, &[]),
+            decal.line(&mesh.rest_positions)
+        );
     }
 }

@@ -18,7 +18,7 @@ mod score;
 pub use attempt::{
     Attempt, ExerciseOptions, ExerciseResult, run_exercise, save_attempt, score_attempt,
 };
-pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, DecalPoints, PlanDecal};
+pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, PlanDecal};
 pub use history::{
     HistoryEntry, append as append_history, read as read_history, table as history_table, utc_now,
 };

@@ -142,6 +142,9 @@ impl ExerciseMode {
                 running.stats.len()
             );
         }
+        if hand.recording().is_none() {
+            bail!("the attempt's stroke recording was stopped; start the attempt again");
+        }
         let Some(running) = self.attempt.take() else {
             bail!("no attempt is under way");
         };

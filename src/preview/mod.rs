@@ -410,6 +410,11 @@ impl Live {
             overlays: self.panel.overlays,
             stress_max: stress_scale(solver),
             tool: crate::tool_view::tool_state(solver),
+            lines: self
+                .exercise
+                .iter()
+                .map(|e| e.decal.line_uncut(solver.positions(), solver.cut().live()))
+                .collect(),
             ..RenderSettings::default()
         };
         let (w, h) = self.gpu.size();
@@ -533,7 +538,11 @@ impl Live {
             ATTEMPT_PICTURE,
             Default::default(),
         )
-        .map(|s| s.with_tool(&session.hand.tool).with_shared_device())
+        .map(|s| {
+            s.with_tool(&session.hand.tool)
+                .with_decal(mode.decal.clone())
+                .with_shared_device()
+        })
         .map_err(|e| format!("no offscreen renderer ({e:#})"));
         mode.start(&mut session.hand, &mut session.body, pictures)?;
         self.panel.draft = session.params;

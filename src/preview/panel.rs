@@ -257,9 +257,10 @@ impl Panel {
         let Some(card) = &self.result_card else {
             return;
         };
-        let size = card.size_vec2() * 0.6;
+        let size = card.size_vec2() * 0.75;
         egui::Window::new("Result")
             .open(&mut self.show_result)
+            .default_pos(egui::pos2(300.0, 40.0))
             .resizable(false)
             .show(ctx, |ui| {
                 ui.image(egui::load::SizedTexture::new(card.id(), size));
