@@ -6,6 +6,8 @@
 struct Globals {
     view_proj: mat4x4<f32>,
     tool_model: mat4x4<f32>,
+    // Local unit square → world of the panel quad.
+    panel_model: mat4x4<f32>,
     // xyz: camera position, w: unused.
     eye: vec4<f32>,
     // xyz: unit direction towards the key light, w: its intensity.
@@ -94,3 +96,4 @@ const ID_TOOL: vec3<f32> = vec3<f32>(1.0, 0.0, 1.0);
 const ID_MARKER: vec3<f32> = vec3<f32>(0.0, 1.0, 1.0);
 const ID_LINE: vec3<f32> = vec3<f32>(1.0, 1.0, 1.0);
 const ID_PLAN: vec3<f32> = vec3<f32>(1.0, 0.2158605, 0.0);
+const ID_PANEL: vec3<f32> = vec3<f32>(0.2158605, 0.0, 1.0);

@@ -29,6 +29,17 @@ pub enum RenderError {
         /// What is wrong.
         why: String,
     },
+    /// An image for the panel quad that cannot be uploaded (the panel keeps its previous
+    /// image).
+    #[error("panel image {width}×{height}: {why}")]
+    PanelImage {
+        /// Image width, pixels.
+        width: u32,
+        /// Image height, pixels.
+        height: u32,
+        /// What is wrong.
+        why: String,
+    },
     /// Reading the image back from the device failed.
     #[error("reading the rendered image back failed: {0}")]
     Readback(String),

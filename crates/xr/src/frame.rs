@@ -66,13 +66,14 @@ pub enum ShadingMode {
     #[default]
     Lit,
     /// Flat colours per material (skin, skin back, cut surface, stress, tool, markers,
-    /// wireframe lines, surface lines; see [`MATERIAL_IDS`]), for tests and picking.
+    /// wireframe lines, surface lines, the panel; see [`MATERIAL_IDS`]), for tests and
+    /// picking.
     MaterialIds,
 }
 
 /// The flat colours of [`ShadingMode::MaterialIds`], by material name, as the bytes of an
 /// sRGB image (the `ID_*` constants of `shaders/render_common.wgsl` are their linear values).
-pub const MATERIAL_IDS: [(&str, [u8; 3]); 8] = [
+pub const MATERIAL_IDS: [(&str, [u8; 3]); 9] = [
     ("skin", [0, 255, 0]),
     ("skin_back", [0, 0, 255]),
     ("cut", [255, 0, 0]),
@@ -81,6 +82,7 @@ pub const MATERIAL_IDS: [(&str, [u8; 3]); 8] = [
     ("marker", [0, 255, 255]),
     ("line", [255, 255, 255]),
     ("plan", [255, 128, 0]),
+    ("panel", [128, 0, 255]),
 ];
 
 /// A line drawn on the tissue surface, e.g. a planned incision (deformed positions).
@@ -126,6 +128,11 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// Lines drawn on the tissue surface.
     pub lines: Vec<SurfaceLine>,
+    /// World placement of the panel quad: the unit square [-0.5,0.5]² of its local xy
+    /// plane (image up = +y, image right = +x, seen from +z), scaled/rotated/translated by
+    /// this; `None` hides it. The image comes from [`crate::Renderer::set_panel_image`]
+    /// (no image: nothing drawn).
+    pub panel: Option<Mat4>,
 }
 
 impl Default for RenderSettings {
@@ -139,6 +146,7 @@ impl Default for RenderSettings {
             background_alpha: 1.0,
             exposure: 1.0,
             lines: Vec::new(),
+            panel: None,
         }
     }
 }

@@ -5,8 +5,9 @@
 //! windows, headsets or the command line. Per frame it deforms the skin on the GPU from
 //! its tet embedding, hides skin triangles of released tets, draws the cut surface in a
 //! wet-tissue material, and adds the switchable overlays (von Mises heat map, tet
-//! wireframe, tool spheres, pinned nodes), the tool mesh and lines drawn on the tissue
-//! surface (planned incisions), with 4× MSAA into sRGB.
+//! wireframe, tool spheres, pinned nodes), the tool mesh, lines drawn on the tissue
+//! surface (planned incisions) and a textured panel quad (result cards), with 4× MSAA into
+//! sRGB.
 
 pub mod camera;
 pub mod colour_map;
@@ -18,6 +19,7 @@ mod gpu_skin;
 pub mod image_io;
 pub mod offscreen;
 pub mod openxr;
+mod panel;
 mod pipelines;
 pub mod renderer;
 mod ribbon;

@@ -1,5 +1,5 @@
-//! The render pipelines, all sharing one layout (the scene bind group), for one colour
-//! format and 4× MSAA.
+//! The render pipelines, all sharing one layout (the scene bind group; the panel adds its
+//! image's group), for one colour format and 4× MSAA.
 
 use crate::shaders;
 
@@ -17,6 +17,7 @@ pub(crate) struct Pipelines {
     pub markers: wgpu::RenderPipeline,
     pub tool: wgpu::RenderPipeline,
     pub surface_line: wgpu::RenderPipeline,
+    pub panel: wgpu::RenderPipeline,
 }
 
 const VEC4: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x4];
@@ -45,6 +46,7 @@ impl Pipelines {
     pub fn new(
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
+        panel_layout: &wgpu::BindGroupLayout,
         format: wgpu::TextureFormat,
     ) -> Self {
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -52,6 +54,12 @@ impl Pipelines {
             bind_group_layouts: &[Some(layout)],
             immediate_size: 0,
         });
+        let panel_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("panel"),
+                bind_group_layouts: &[Some(layout), Some(panel_layout)],
+                immediate_size: 0,
+            });
         let make = |s: Spec<'_>| {
             let module = shaders::module(device, s.shader);
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -193,6 +201,17 @@ impl Pipelines {
                 topology: tris,
                 depth: solid,
                 blend: None,
+            }),
+            // Straight-alpha image after the opaque geometry: depth-tested, not written.
+            panel: make(Spec {
+                layout: &panel_pipeline_layout,
+                shader: "panel",
+                vs: "vs",
+                fs: "fs",
+                buffers: &[],
+                topology: tris,
+                depth: (false, wgpu::CompareFunction::Less),
+                blend: Some(wgpu::BlendState::ALPHA_BLENDING),
             }),
         }
     }

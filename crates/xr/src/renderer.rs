@@ -11,6 +11,7 @@ use crate::camera::View;
 use crate::error::RenderError;
 use crate::frame::{BodyState, RenderSettings, ShadingMode};
 use crate::gpu_skin::GpuSkin;
+use crate::panel::Panel;
 use crate::pipelines::Pipelines;
 use crate::scene_buffers::{GLOBALS_STRIDE, Globals, MAX_VIEWS, SceneBuffers};
 use crate::targets::Attachments;
@@ -77,8 +78,8 @@ struct Timer {
     period_ns: f32,
 }
 
-/// Draws one body (tet mesh + skin) with its cut surface, overlays, tool and surface
-/// lines.
+/// Draws one body (tet mesh + skin) with its cut surface, overlays, tool, surface lines
+/// and panel quad.
 pub struct Renderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -88,6 +89,7 @@ pub struct Renderer {
     skin: GpuSkin,
     tool: MeshBuffers,
     sphere: MeshBuffers,
+    panel: Panel,
     attachments: Option<Attachments>,
     settings: RenderSettings,
     timer: Option<Timer>,
@@ -105,8 +107,10 @@ impl Renderer {
     ) -> Self {
         let scene = SceneBuffers::new(device, mesh, skin);
         let skin_gpu = GpuSkin::new(device, skin, &scene.nodes);
+        let panel = Panel::new(device);
         Renderer {
-            pipelines: Pipelines::new(device, &scene.layout, format),
+            pipelines: Pipelines::new(device, &scene.layout, &panel.layout, format),
+            panel,
             tool: MeshBuffers::new(device, &ToolMesh::scalpel()),
             sphere: MeshBuffers::positions_only(device, &ToolMesh::unit_sphere(2)),
             skin: skin_gpu,
@@ -124,6 +128,23 @@ impl Renderer {
     /// tool from now on, instead of the stand-in blade.
     pub fn set_tool_mesh(&mut self, mesh: &ToolMesh) {
         self.tool = MeshBuffers::new(&self.device, mesh);
+    }
+
+    /// Upload the image shown on the panel quad (RGBA8, sRGB, row-major, top row first);
+    /// `None` removes it. The quad is drawn where [`RenderSettings::panel`] places it,
+    /// only while an image is set.
+    ///
+    /// # Errors
+    /// [`RenderError::PanelImage`] when the byte count is not width · height · 4, a side
+    /// is zero, or a side exceeds the device's largest 2D texture; the panel then keeps
+    /// its previous image.
+    pub fn set_panel_image(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        image: Option<(&[u8], u32, u32)>,
+    ) -> Result<(), RenderError> {
+        self.panel.set(device, queue, image)
     }
 
     /// The colour format this renderer draws.
@@ -210,11 +231,13 @@ impl Renderer {
         let s = &self.settings;
         let ids = s.shading == ShadingMode::MaterialIds;
         let tool_model = s.tool.transform.unwrap_or(Mat4::IDENTITY);
+        let panel_model = s.panel.unwrap_or(Mat4::IDENTITY);
         for (i, (view, _)) in views.iter().enumerate() {
             let eye = view.eye();
             let g = Globals {
                 view_proj: view.view_proj().to_cols_array_2d(),
                 tool_model: tool_model.to_cols_array_2d(),
+                panel_model: panel_model.to_cols_array_2d(),
                 eye: [eye.x, eye.y, eye.z, 1.0],
                 light: LIGHT_DIR.normalize().extend(LIGHT_INTENSITY).to_array(),
                 misc: [
@@ -323,6 +346,12 @@ impl Renderer {
             pass.set_pipeline(&self.pipelines.surface_line);
             pass.set_vertex_buffer(0, sc.lines.buffer.slice(..));
             pass.draw(0..sc.lines.len, 0..1);
+        }
+        // Blended, so after every opaque surface; the x-ray wireframe stays on top.
+        if let (Some(_), Some(image)) = (s.panel, self.panel.bind_group()) {
+            pass.set_pipeline(&self.pipelines.panel);
+            pass.set_bind_group(1, image, &[]);
+            pass.draw(0..6, 0..1);
         }
         if s.overlays.wireframe && sc.edges.len > 0 {
             pass.set_pipeline(&self.pipelines.wireframe);

@@ -24,6 +24,7 @@ pub(crate) const MAX_VIEWS: u64 = 4;
 pub(crate) struct Globals {
     pub view_proj: [[f32; 4]; 4],
     pub tool_model: [[f32; 4]; 4],
+    pub panel_model: [[f32; 4]; 4],
     pub eye: [f32; 4],
     pub light: [f32; 4],
     pub misc: [f32; 4],

@@ -4,13 +4,14 @@
 const COMMON: &str = include_str!("../../../shaders/render_common.wgsl");
 
 /// Render shaders (each `shaders/<name>.wgsl`, with the common part prepended).
-pub const RENDER_SHADERS: [&str; 6] = [
+pub const RENDER_SHADERS: [&str; 7] = [
     "skin",
     "tet_faces",
     "wireframe",
     "markers",
     "tool",
     "surface_line",
+    "panel",
 ];
 
 /// Compute shaders of the skin deformation (each `shaders/<name>.wgsl`).
@@ -26,6 +27,7 @@ pub fn source(name: &str) -> Option<String> {
         "markers" => render(include_str!("../../../shaders/markers.wgsl")),
         "tool" => render(include_str!("../../../shaders/tool.wgsl")),
         "surface_line" => render(include_str!("../../../shaders/surface_line.wgsl")),
+        "panel" => render(include_str!("../../../shaders/panel.wgsl")),
         "skin_deform" => include_str!("../../../shaders/skin_deform.wgsl").to_string(),
         "skin_normals" => include_str!("../../../shaders/skin_normals.wgsl").to_string(),
         _ => return None,

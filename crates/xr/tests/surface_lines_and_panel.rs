@@ -1,19 +1,20 @@
 //! Issue 10, the renderer side of training exercises: a line drawn on the tissue surface
 //! (the planned incision, following the deformed tissue, hidden where the organ is in
-//! front of it), offscreen on any adapter (lavapipe in CI).
+//! front of it) and a textured panel quad in the world (the result card), offscreen on
+//! any adapter (lavapipe in CI).
 //!
 //! Without an adapter the tests print why and pass, unless `INCISE_REQUIRE_GPU=1` (CI):
 //! then they fail.
 
-use glam::{Mat4, UVec3, Vec2, Vec3};
+use glam::{Mat4, Quat, UVec3, Vec2, Vec3};
 use incise_sim::TetMesh;
 use incise_sim::cutting::CutState;
 use incise_sim::generate::block;
 use incise_sim::skin::Skin;
 use incise_xr::frame::MATERIAL_IDS;
 use incise_xr::{
-    BodyState, Camera, OffscreenRenderer, RenderDevice, RenderSettings, RgbaImage, ShadingMode,
-    SurfaceLine, View,
+    BodyState, Camera, OffscreenRenderer, RenderDevice, RenderError, RenderSettings, RgbaImage,
+    ShadingMode, SurfaceLine, View,
 };
 
 const SIZE: (u32, u32) = (320, 240);
@@ -76,10 +77,11 @@ fn line_across(y: f32, offset: Vec3) -> SurfaceLine {
     }
 }
 
-fn ids(lines: Vec<SurfaceLine>) -> RenderSettings {
+fn ids(lines: Vec<SurfaceLine>, panel: Option<Mat4>) -> RenderSettings {
     RenderSettings {
         shading: ShadingMode::MaterialIds,
         lines,
+        panel,
         ..RenderSettings::default()
     }
 }
@@ -128,7 +130,7 @@ fn a_line_on_the_plate_is_drawn_with_its_width_and_hidden_from_below() {
     };
     let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 1).unwrap();
     let line = line_across(0.01, Vec3::ZERO);
-    let settings = ids(vec![line.clone()]);
+    let settings = ids(vec![line.clone()], None);
     let view = vertical_view(true);
     let img = r.render_image(&state, &settings, &view).unwrap();
     assert_plan_along(&img, &view, &line, "from above");
@@ -172,7 +174,7 @@ fn a_line_on_the_plate_is_drawn_with_its_width_and_hidden_from_below() {
         "the plate is in view from below"
     );
     // Without lines, no plan pixels.
-    let none = r.render_image(&state, &ids(vec![]), &view).unwrap();
+    let none = r.render_image(&state, &ids(vec![], None), &view).unwrap();
     assert_eq!(count(&none, "plan"), 0);
 }
 
@@ -197,7 +199,7 @@ fn the_line_follows_the_deformed_tissue() {
     let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 1).unwrap();
     let view = vertical_view(true);
     let img = r
-        .render_image(&state, &ids(vec![moved_line.clone()]), &view)
+        .render_image(&state, &ids(vec![moved_line.clone()], None), &view)
         .unwrap();
     assert_plan_along(&img, &view, &moved_line, "moved");
     for p in rest_line.points.iter().step_by(10).skip(1).take(6) {
@@ -211,12 +213,182 @@ fn the_line_follows_the_deformed_tissue() {
         p.y -= 0.02;
     }
     let img = r
-        .render_image(&state, &ids(vec![bent.clone()]), &view)
+        .render_image(&state, &ids(vec![bent.clone()], None), &view)
         .unwrap();
     for i in [5, 15, 35, 40, 45, 65, 75] {
         let px = view.project(bent.points[i], full()).unwrap();
         assert!(is_material(&img, px, "plan"), "point {i} of the bent line");
     }
+}
+
+/// A 4 × 4 image in quadrants: top left red, top right blue, bottom left green, bottom
+/// right transparent.
+fn quadrants() -> Vec<u8> {
+    let mut img = Vec::new();
+    for y in 0..4 {
+        for x in 0..4 {
+            img.extend_from_slice(match (x < 2, y < 2) {
+                (true, true) => &[255, 0, 0, 255],
+                (false, true) => &[0, 0, 255, 255],
+                (true, false) => &[0, 255, 0, 255],
+                (false, false) => &[255, 255, 255, 0],
+            });
+        }
+    }
+    img
+}
+
+#[test]
+fn the_panel_shows_its_image_the_right_way_round_over_the_scene() {
+    let Some(dev) = device() else { return };
+    let (mesh, skin) = plate();
+    let cut = CutState::new(&mesh);
+    let vm = vec![0.0; mesh.tet_count()];
+    let state = BodyState {
+        positions: &mesh.rest_positions,
+        device_positions: None,
+        cut: &cut,
+        von_mises: &vm,
+        pinned: &[],
+    };
+    let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 1).unwrap();
+    let view = vertical_view(true);
+    // 6 cm square, 3 cm above the plate, facing the camera (+z).
+    let centre = Vec3::new(0.0, 0.0, 0.03);
+    let placement =
+        Mat4::from_scale_rotation_translation(Vec3::new(0.06, 0.06, 1.0), Quat::IDENTITY, centre);
+    let at = |dx: f32, dy: f32| {
+        view.project(centre + Vec3::new(dx, dy, 0.0), full())
+            .unwrap()
+    };
+    let (tl, tr, bl, br) = (
+        at(-0.015, 0.015),
+        at(0.015, 0.015),
+        at(-0.015, -0.015),
+        at(0.015, -0.015),
+    );
+    let lit = |panel| RenderSettings {
+        panel,
+        ..RenderSettings::default()
+    };
+    let pixel = |img: &RgbaImage, p: Vec2| img.get(p.x as u32, p.y as u32);
+    let near =
+        |c: [u8; 4], want: [u8; 4]| (0..4).all(|k| (c[k] as i32 - want[k] as i32).abs() <= 2);
+    // Placed but no image yet: nothing drawn.
+    let plain = r.render_image(&state, &lit(None), &view).unwrap();
+    let no_image = r
+        .render_image(&state, &lit(Some(placement)), &view)
+        .unwrap();
+    assert_eq!(no_image, plain, "a panel without an image is drawn");
+
+    let image = quadrants();
+    r.renderer
+        .set_panel_image(&dev.device, &dev.queue, Some((&image, 4, 4)))
+        .unwrap();
+    let img = r
+        .render_image(&state, &lit(Some(placement)), &view)
+        .unwrap();
+    assert!(
+        near(pixel(&img, tl), [255, 0, 0, 255]),
+        "top left {:?}",
+        pixel(&img, tl)
+    );
+    assert!(
+        near(pixel(&img, tr), [0, 0, 255, 255]),
+        "top right {:?}",
+        pixel(&img, tr)
+    );
+    assert!(
+        near(pixel(&img, bl), [0, 255, 0, 255]),
+        "bottom left {:?}",
+        pixel(&img, bl)
+    );
+    assert!(
+        near(pixel(&img, br), pixel(&plain, br)),
+        "the clear quadrant hides the plate: {:?}",
+        pixel(&img, br)
+    );
+    // Outside the quad, the picture is unchanged.
+    let outside = at(0.04, 0.0);
+    assert_eq!(pixel(&img, outside), pixel(&plain, outside));
+    // Hidden: nothing of the panel.
+    let hidden = r.render_image(&state, &lit(None), &view).unwrap();
+    assert_eq!(hidden, plain);
+
+    // In id mode: the panel colour where the image is opaque, the skin through the rest.
+    let img = r
+        .render_image(&state, &ids(vec![], Some(placement)), &view)
+        .unwrap();
+    for p in [tl, tr, bl] {
+        assert!(is_material(&img, p, "panel"), "{p}: {:?}", pixel(&img, p));
+    }
+    assert!(is_material(&img, br, "skin"), "{:?}", pixel(&img, br));
+
+    // Seen from behind (turned half round about y): drawn, mirrored.
+    let behind = placement * Mat4::from_rotation_y(std::f32::consts::PI);
+    let img = r.render_image(&state, &lit(Some(behind)), &view).unwrap();
+    assert!(
+        near(pixel(&img, tr), [255, 0, 0, 255]),
+        "{:?}",
+        pixel(&img, tr)
+    );
+    assert!(
+        near(pixel(&img, tl), [0, 0, 255, 255]),
+        "{:?}",
+        pixel(&img, tl)
+    );
+
+    // Below the plate's top, the tissue hides it (depth-tested).
+    let sunk = Mat4::from_translation(Vec3::new(0.0, 0.0, -0.035)) * placement;
+    let img = r.render_image(&state, &lit(Some(sunk)), &view).unwrap();
+    assert_eq!(img, plain, "the panel shows through the plate");
+
+    // Bad images are refused and the panel keeps its image.
+    let max = dev.device.limits().max_texture_dimension_2d;
+    let too_wide = vec![0u8; (max as usize + 1) * 4];
+    for (bytes, w, h) in [
+        (&image[..60], 4, 4),
+        (&image[..], 8, 2 + 1),
+        (&image[..0], 0, 4),
+        (&image[..0], 4, 0),
+        (&too_wide[..], max + 1, 1),
+    ] {
+        let e = r
+            .renderer
+            .set_panel_image(&dev.device, &dev.queue, Some((bytes, w, h)))
+            .unwrap_err();
+        assert!(
+            matches!(e, RenderError::PanelImage { width, height, .. } if (width, height) == (w, h)),
+            "{e}"
+        );
+    }
+    let img = r
+        .render_image(&state, &lit(Some(placement)), &view)
+        .unwrap();
+    assert!(
+        near(pixel(&img, tl), [255, 0, 0, 255]),
+        "the image was lost"
+    );
+    // A new image of another size replaces it; `None` removes it.
+    let blue = [0u8, 0, 255, 255].repeat(3 * 2);
+    r.renderer
+        .set_panel_image(&dev.device, &dev.queue, Some((&blue, 3, 2)))
+        .unwrap();
+    let img = r
+        .render_image(&state, &lit(Some(placement)), &view)
+        .unwrap();
+    assert!(
+        near(pixel(&img, tl), [0, 0, 255, 255]),
+        "{:?}",
+        pixel(&img, tl)
+    );
+    r.renderer
+        .set_panel_image(&dev.device, &dev.queue, None)
+        .unwrap();
+    let img = r
+        .render_image(&state, &lit(Some(placement)), &view)
+        .unwrap();
+    assert_eq!(img, plain, "the removed image is still drawn");
 }
 
 #[test]
@@ -242,7 +414,7 @@ fn both_stereo_eyes_draw_the_line() {
         .collect();
     let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 2).unwrap();
     let line = line_across(-0.01, Vec3::ZERO);
-    r.render(&state, &ids(vec![line.clone()]), &eyes);
+    r.render(&state, &ids(vec![line.clone()], None), &eyes);
     for (i, eye) in eyes.iter().enumerate() {
         let img = r.read_image(i as u32).unwrap();
         assert_plan_along(&img, eye, &line, &format!("eye {i}"));
