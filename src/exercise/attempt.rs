@@ -1,6 +1,8 @@
 //! `incise exercise`: run the exercise's scene with a stroke driving its scalpel (the
 //! `incise run` machinery, unchanged), measure the cut, score it, write `result.json`
-//! and `report.html`, and append the attempt to the results history.
+//! and `report.html`, and append the attempt to the results history. Scoring a
+//! simulation state ([`score_attempt`]) and saving an attempt ([`save_attempt`]) are
+//! the same for the preview's and the headset's live attempts.
 
 use std::path::{Path, PathBuf};
 
