@@ -606,10 +606,10 @@ impl Live {
         }
         let dev = &self.gpu.dev;
         let result = match action {
-            Action::Load(path) => {
+            Action::Load(path) => self.load_scene(&path).map(|()| {
                 self.exercise = None;
-                self.load_scene(&path).map(|()| "loaded".to_string())
-            }
+                "loaded".to_string()
+            }),
             Action::OpenExercise(path) => self.open_exercise(&path),
             Action::StartAttempt { reference } => self.start_attempt(reference),
             Action::FinishAttempt => self.finish_attempt(),
