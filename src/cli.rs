@@ -84,6 +84,11 @@ pub enum Command {
         /// Window size, WIDTHxHEIGHT.
         #[arg(long, default_value = "1280x800")]
         size: ImageSize,
+        /// Open this exercise (config/exercises/*.ron): its scene, the planned incision
+        /// drawn on the tissue, attempts scored and saved to out/exercises/ and
+        /// results/history.jsonl.
+        #[arg(long, conflicts_with = "scene")]
+        exercise: Option<PathBuf>,
     },
     /// The scene on a tray in the room of an OpenXR headset (Meta Quest 3 over Link,
     /// WiVRn/Monado), cut with the right controller; exits 2 when no runtime or headset

@@ -25,6 +25,7 @@ fn default_command() -> Command {
             screenshot: None,
             device: incise::body::DeviceChoice::Auto,
             size: ImageSize(1280, 800),
+            exercise: None,
         },
         Some(why) => {
             eprintln!(
@@ -92,6 +93,7 @@ fn main() -> ExitCode {
             record_stroke,
             inject_gpu_loss_at,
             inject_nan_at,
+            screenshot_decal: None,
         })
         .map(|o| {
             println!("{}", o.report.summary());
@@ -103,12 +105,14 @@ fn main() -> ExitCode {
             screenshot,
             device,
             size,
+            exercise,
         } => preview::run(PreviewOptions {
             scene: scene.unwrap_or_else(|| DEFAULT_SCENE.into()),
             frames,
             screenshot,
             device,
             size,
+            exercise,
         }),
         Command::Xr {
             scene,

@@ -90,7 +90,7 @@ pub struct SegmentPanel {
 }
 
 /// Register the embedded font for plotters' "sans-serif" family (once per process).
-fn register_fonts() {
+pub fn register_fonts() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The bytes are a valid TrueType file checked into the repository.

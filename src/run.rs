@@ -10,6 +10,7 @@ use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
 use incise_sim::xpbd::SolverError;
 
 use crate::body::{Body, DeviceChoice};
+use crate::exercise::PlanDecal;
 use crate::progress::Progress;
 use crate::report::{FrameData, FrameRecord, MaterialInfo, MeshInfo, Report, ToolInfo};
 use crate::scene::{BuiltScene, ToolDriver, build_scene_driven, load_scene};
@@ -51,6 +52,8 @@ pub struct RunOptions {
     pub inject_gpu_loss_at: Option<u64>,
     /// Fault injection for tests: a NaN velocity on the first free node before this frame.
     pub inject_nan_at: Option<u64>,
+    /// Draw this planned incision on the screenshots (exercise runs; Xpbd scenes).
+    pub screenshot_decal: Option<PlanDecal>,
 }
 
 /// What a finished run produced.
@@ -131,8 +134,12 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
                 opts.screenshot_size,
                 Default::default(),
             )?;
-            Some(match &tool {
+            let shots = match &tool {
                 Some((t, _)) => shots.with_tool(&t.tool),
+                None => shots,
+            };
+            Some(match &opts.screenshot_decal {
+                Some(d) => shots.with_decal(d.clone()),
                 None => shots,
             })
         }

@@ -12,10 +12,11 @@ use incise_sim::skin::Skin;
 use incise_sim::{Solver, TetMesh};
 use incise_xr::frame::pinned_nodes;
 use incise_xr::{
-    BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, View,
+    BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View,
 };
 
 use crate::body::{Body, DeviceChoice};
+use crate::exercise::PlanDecal;
 
 /// An image size `WIDTHxHEIGHT` given on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -105,6 +106,8 @@ pub struct Screenshots {
     shared_device: bool,
     /// Whether the solver's tool is drawn (its mesh given by [`Screenshots::with_tool`]).
     draw_tool: bool,
+    /// A planned incision drawn on the tissue (where it is not cut away).
+    decal: Option<PlanDecal>,
 }
 
 impl Screenshots {
@@ -137,6 +140,7 @@ impl Screenshots {
             pinned: pinned_nodes(solver),
             shared_device: false,
             draw_tool: false,
+            decal: None,
         })
     }
 
@@ -150,6 +154,12 @@ impl Screenshots {
         self
     }
 
+    /// Draw `decal` (an exercise's plan) on the tissue, following its deformation.
+    pub fn with_decal(mut self, decal: PlanDecal) -> Self {
+        self.decal = Some(decal);
+        self
+    }
+
     /// Declare that GPU bodies given to [`Screenshots::save`] live on this renderer's device.
     pub fn with_shared_device(mut self) -> Self {
         self.shared_device = true;
@@ -158,19 +168,29 @@ impl Screenshots {
 
     /// Render `body` now and write the PNG to `path`.
     pub fn save(&mut self, body: &Body, path: &Path) -> Result<()> {
+        self.image(body)?
+            .save_png(path)
+            .with_context(|| format!("writing screenshot {}", path.display()))
+    }
+
+    /// Render `body` now.
+    pub fn image(&mut self, body: &Body) -> Result<RgbaImage> {
         let solver = body.solver();
         if self.draw_tool {
             self.settings.tool = crate::tool_view::tool_state(solver);
         }
+        self.settings.lines = self
+            .decal
+            .iter()
+            .map(|d| d.line_uncut(solver.positions(), solver.cut().live()))
+            .collect();
         let mut state = BodyState::of_solver(solver, &self.pinned);
         if let (Body::Gpu(g), true) = (body, self.shared_device) {
             state.device_positions = Some(g.position_buffer());
         }
-        let img = self
+        Ok(self
             .offscreen
-            .render_image(&state, &self.settings, &self.view)?;
-        img.save_png(path)
-            .with_context(|| format!("writing screenshot {}", path.display()))
+            .render_image(&state, &self.settings, &self.view)?)
     }
 }
 

@@ -176,6 +176,22 @@ fn stroke_on_the_plan_passes_and_one_cm_off_fails_on_deviation() {
         on["metrics"]
     );
     assert_eq!(on["verdict"]["passed"], true, "{}", on["verdict"]);
+    // With an offscreen renderer, the report's pictures show the plan as a violet line
+    // on the tissue.
+    let before = dir.join("on/frame_00000.png");
+    if before.is_file() {
+        let img = incise_xr::RgbaImage::load_png(&before).unwrap();
+        let violet = img
+            .pixels
+            .chunks_exact(4)
+            .filter(|p| p[2] as i32 > p[1] as i32 + 60 && p[0] as i32 > p[1] as i32 + 20)
+            .count();
+        assert!(
+            violet > 50,
+            "no plan line in {}: {violet} violet pixels",
+            before.display()
+        );
+    }
     let off = attempt(
         &dir,
         "off",

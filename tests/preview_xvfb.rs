@@ -166,6 +166,56 @@ wait $P"#,
 }
 
 #[test]
+fn an_exercise_draws_its_plan_on_the_tissue() {
+    if Command::new("xvfb-run").arg("--help").output().is_err() {
+        assert!(!required(), "INCISE_REQUIRE_GPU=1 but xvfb-run is missing");
+        eprintln!("skipping: xvfb-run is not installed");
+        return;
+    }
+    let dir = temp_dir("xvfb-exercise");
+    let shot = dir.join("exercise.png");
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_incise"))
+        .args([
+            "preview",
+            "--exercise",
+            "config/exercises/slab_depth.ron",
+            "--frames",
+            "10",
+            "--size",
+            "900x600",
+        ])
+        .args(["--device", "cpu", "--screenshot"])
+        .arg(&shot)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", &dir)
+        .output()
+        .expect("xvfb-run runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    if !o.status.success() && err.contains("no GPU adapter") && !required() {
+        eprintln!("skipping: {err}");
+        return;
+    }
+    assert!(o.status.success(), "preview failed: {err}");
+    let img = RgbaImage::load_png(&shot).unwrap();
+    // The violet marker line (blue well above green, red between) in the 3D view, right
+    // of the panel: a 3 cm line 1 mm wide.
+    let violet = (0..img.height)
+        .flat_map(|y| (300..img.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.get(x, y);
+            p[2] as i32 > p[1] as i32 + 60 && p[0] as i32 > p[1] as i32 + 20
+        })
+        .count();
+    eprintln!("{violet} violet pixels");
+    assert!(
+        (60..5000).contains(&violet),
+        "the plan line should be on the tissue: {violet} violet pixels"
+    );
+}
+
+#[test]
 fn without_a_display_preview_refuses_and_the_default_runs_headless() {
     let o = Command::new(env!("CARGO_BIN_EXE_incise"))
         .args(["preview", "config/beam_sag.ron"])

@@ -1,14 +1,18 @@
 //! `incise exercise`: run the exercise's scene with a stroke driving its scalpel (the
 //! `incise run` machinery, unchanged), measure the cut, score it, write `result.json`
-//! and `report.html`, and append the attempt to the results history.
+//! and `report.html`, and append the attempt to the results history. Scoring a
+//! simulation state ([`score_attempt`]) and saving an attempt ([`save_attempt`]) are
+//! the same for the preview's and the headset's live attempts.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use incise_sim::xpbd::FrameStats;
 use serde::Serialize;
 
+use super::decal::PlanDecal;
 use super::history::{self, HistoryEntry};
-use super::load::load_exercise;
+use super::load::{LoadedExercise, load_exercise};
 use super::metrics::{self, Metrics};
 use super::model::{PassThresholds, Tolerance};
 use super::report_html::{self, CutImages};
@@ -85,7 +89,9 @@ pub struct Attempt {
     pub html_path: PathBuf,
 }
 
-/// Score `opts.stroke` on `opts.exercise`.
+/// Score `opts.stroke` on `opts.exercise`: the stroke replayed by `incise run`'s
+/// machinery for its duration plus [`SETTLE_TIME`], then [`score_attempt`] and
+/// [`save_attempt`] into `opts.out`.
 pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
     let ex = load_exercise(&opts.exercise)?;
     let stroke = incise_scalpel::load_stroke(&opts.stroke)?;
@@ -110,12 +116,15 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
         record_stroke: None,
         inject_gpu_loss_at: None,
         inject_nan_at: None,
+        screenshot_decal: Some(PlanDecal::new(&ex.plan, &ex.mesh)),
     })
     .with_context(|| format!("{}: running the attempt", opts.exercise.display()))?;
     let report = outcome.report;
     let mut released = vec![false; ex.mesh.tet_count()];
     for &t in &report.released_tets {
-        released[t as usize] = true;
+        if let Some(r) = released.get_mut(t as usize) {
+            *r = true;
+        }
     }
     let stats: Vec<_> = report
         .frames
@@ -128,29 +137,14 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
     if stats.len() != report.frames.len() {
         bail!("{}: exercises need an Xpbd scene", ex.scene_path.display());
     }
-    let metrics = metrics::compute(&ex.exercise, &ex.plan, &ex.mesh, &released, &stats, dt);
-    let verdict = score::judge(&ex.exercise, &metrics);
-    let e = &ex.exercise;
-    let result = ExerciseResult {
-        exercise: e.name.clone(),
-        exercise_file: opts.exercise.display().to_string(),
-        description: e.description.clone(),
-        scene_file: ex.scene_path.display().to_string(),
-        stroke_file: opts.stroke.display().to_string(),
-        device: report.device.clone(),
-        time: history::utc_now(),
+    let result = score_attempt(
+        &ex,
+        &opts.stroke.display().to_string(),
+        report.device.clone(),
+        &released,
+        &stats,
         frames,
-        plan: ex.plan.points.iter().map(|p| p.to_array()).collect(),
-        target_depth: e.depth,
-        tolerance: e.tolerance,
-        time_limit: e.time_limit,
-        thresholds: e.pass,
-        metrics,
-        verdict,
-    };
-    let result_path = opts.out.join("result.json");
-    std::fs::write(&result_path, serde_json::to_string_pretty(&result)?)
-        .with_context(|| format!("writing {}", result_path.display()))?;
+    )?;
     let first = opts.out.join("frame_00000.png");
     let last = opts.out.join(format!("frame_{frames:05}.png"));
     let pictures = match images {
@@ -160,9 +154,72 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
         ]),
         Some(why) => CutImages::Missing(why),
     };
-    let html_path = report_html::write(&opts.out, &result, &pictures)?;
+    save_attempt(&opts.out, result, &pictures, &opts.history)
+}
+
+/// Score an attempt on `ex` from the simulation state it left: `released[t]` for every
+/// tet of the exercise's mesh, the statistics of each of the `frames` simulated frames
+/// (`stats`), the stroke (`stroke_label`, as written in the results) and the solver's
+/// `device`. The one scoring of the command line, the preview and the headset.
+pub fn score_attempt(
+    ex: &LoadedExercise,
+    stroke_label: &str,
+    device: String,
+    released: &[bool],
+    stats: &[FrameStats],
+    frames: u64,
+) -> Result<ExerciseResult> {
+    if released.len() != ex.mesh.tet_count() {
+        bail!(
+            "{}: the attempt's body has {} tets, the exercise's mesh {}: not the exercise's \
+             scene",
+            ex.path.display(),
+            released.len(),
+            ex.mesh.tet_count()
+        );
+    }
+    let dt = ex.scene.solver.frame_dt as f64;
+    let metrics = metrics::compute(&ex.exercise, &ex.plan, &ex.mesh, released, stats, dt);
+    let verdict = score::judge(&ex.exercise, &metrics);
+    let e = &ex.exercise;
+    Ok(ExerciseResult {
+        exercise: e.name.clone(),
+        exercise_file: ex.path.display().to_string(),
+        description: e.description.clone(),
+        scene_file: ex.scene_path.display().to_string(),
+        stroke_file: stroke_label.to_string(),
+        device,
+        time: history::utc_now(),
+        frames,
+        plan: ex.plan.points.iter().map(|p| p.to_array()).collect(),
+        target_depth: e.depth,
+        tolerance: e.tolerance,
+        time_limit: e.time_limit,
+        thresholds: e.pass,
+        metrics,
+        verdict,
+    })
+}
+
+/// Save a scored attempt into `out_dir` (created): `result.json` (atomically),
+/// `report.html` with `images` and its plots, and one line appended to the results
+/// history at `history_path`.
+pub fn save_attempt(
+    out_dir: &Path,
+    result: ExerciseResult,
+    images: &CutImages,
+    history_path: &Path,
+) -> Result<Attempt> {
+    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    let result_path = out_dir.join("result.json");
+    incise_sim::io::write_atomic(
+        &result_path,
+        serde_json::to_string_pretty(&result)?.as_bytes(),
+    )
+    .with_context(|| format!("writing {}", result_path.display()))?;
+    let html_path = report_html::write(out_dir, &result, images)?;
     history::append(
-        &opts.history,
+        history_path,
         &HistoryEntry {
             time: result.time.clone(),
             exercise: result.exercise.clone(),

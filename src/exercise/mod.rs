@@ -4,6 +4,7 @@
 //! local history of attempts. Definitions: docs/scoring.md.
 
 mod attempt;
+mod decal;
 mod history;
 mod load;
 mod metrics;
@@ -11,15 +12,21 @@ mod model;
 mod plan;
 mod reference;
 mod report_html;
+mod result_card;
 mod score;
 
-pub use attempt::{Attempt, ExerciseOptions, ExerciseResult, run_exercise};
+pub use attempt::{
+    Attempt, ExerciseOptions, ExerciseResult, run_exercise, save_attempt, score_attempt,
+};
+pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, PlanDecal};
 pub use history::{
-    HistoryEntry, append as append_history, read as read_history, table as history_table,
+    HistoryEntry, append as append_history, read as read_history, table as history_table, utc_now,
 };
 pub use load::{LoadedExercise, load_exercise, parse_exercise};
 pub use metrics::{Metrics, STROKE_GAP_FRAMES, compute as compute_metrics};
 pub use model::{Exercise, PassThresholds, Tolerance};
 pub use plan::{Plan, PlanCoords, PlanSample, RestSurface};
 pub use reference::{ReferenceStyle, reference_stroke, write_reference_stroke};
+pub use report_html::CutImages;
+pub use result_card::{BANNER, CARD_SIZE, FAIL_COLOUR, PASS_COLOUR, Standing, render_card};
 pub use score::{Check, Verdict, WEIGHTS, Weights, judge};

@@ -189,7 +189,8 @@ pub fn write(dir: &Path, r: &ExerciseResult, images: &CutImages) -> Result<std::
     }
     html.push_str("</body></html>\n");
     let path = dir.join("report.html");
-    std::fs::write(&path, html).with_context(|| format!("writing {}", path.display()))?;
+    incise_sim::io::write_atomic(&path, html.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
     Ok(path)
 }
 

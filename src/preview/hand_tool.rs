@@ -103,6 +103,13 @@ impl HandTool {
         }
     }
 
+    /// Let `stroke` move the tool from frame 0 on, instead of the scene's (e.g. an
+    /// exercise's reference stroke), until the mouse takes the blade.
+    pub fn play(&mut self, stroke: Stroke) {
+        self.stroke = Some(stroke);
+        self.play_stroke = true;
+    }
+
     /// Let the mouse move the blade from where the scene's stroke has it at `frame`.
     pub fn take_mouse(&mut self, frame: u64, dt: f64) {
         if self.play_stroke {

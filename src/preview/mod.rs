@@ -2,9 +2,12 @@
 //! side panel, orbit/pan/zoom and the mouse scalpel (left-drag cuts, see
 //! [`scalpel_input`]). `--frames N` renders N frames and exits (for tests and scripts);
 //! `--screenshot FILE` saves the window's last frame (also when Escape closes it).
+//! `--exercise FILE` opens an exercise ([`exercise_mode`]): its plan drawn on the tissue,
+//! attempts scored live and saved.
 
 mod camera_input;
 pub mod display;
+pub mod exercise_mode;
 mod frame_times;
 pub mod hand_tool;
 mod panel;
@@ -25,7 +28,7 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Fullscreen, Window, WindowId};
 
 use crate::body::{Body, DeviceChoice};
-use crate::screenshots::{ImageSize, default_camera, stress_scale};
+use crate::screenshots::{ImageSize, Screenshots, default_camera, stress_scale};
 
 /// The preview's start view: the default one, a little farther out (the panel takes room).
 fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
@@ -34,8 +37,9 @@ fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
     cam
 }
 use camera_input::{CameraInput, KeyAction, wheel_steps};
+use exercise_mode::ExerciseMode;
 use frame_times::{FrameTime, FrameTimes};
-use panel::{Action, Panel, PanelInfo, ScalpelInfo};
+use panel::{Action, ExerciseInfo, Panel, PanelInfo, ScalpelInfo};
 use session::{Session, scene_files};
 use window_gpu::{PanelFrame, WindowGpu};
 
@@ -52,7 +56,18 @@ pub struct PreviewOptions {
     pub device: DeviceChoice,
     /// Window size.
     pub size: ImageSize,
+    /// Open this exercise (its scene instead of `scene`).
+    pub exercise: Option<PathBuf>,
 }
+
+/// Where the preview saves exercise attempts, one folder each.
+pub const ATTEMPTS_DIR: &str = "out/exercises";
+
+/// The results history preview attempts are appended to (`incise exercise`'s default).
+pub const HISTORY_FILE: &str = "results/history.jsonl";
+
+/// Size of the report's pictures of a preview attempt.
+const ATTEMPT_PICTURE: ImageSize = ImageSize(960, 540);
 
 /// Open the preview window and run until it is closed (or `--frames` are done).
 pub fn run(opts: PreviewOptions) -> Result<()> {
@@ -103,6 +118,8 @@ struct Live {
     ctrl: bool,
     /// Escape was pressed: the next frame is the last.
     quitting: bool,
+    /// The open exercise.
+    exercise: Option<ExerciseMode>,
 }
 
 impl ApplicationHandler for App {
@@ -214,7 +231,21 @@ impl Live {
             DeviceChoice::Auto => DeviceChoice::Gpu,
             d => d,
         };
-        let session = Session::load(&opts.scene, device, &gpu.dev)?;
+        let exercise = opts
+            .exercise
+            .as_deref()
+            .map(ExerciseMode::open)
+            .transpose()?;
+        let scene = exercise
+            .as_ref()
+            .map_or(opts.scene.clone(), |e| e.scene_path().to_path_buf());
+        let mut session = Session::load(&scene, device, &gpu.dev)?;
+        if exercise.is_some() {
+            // The mouse holds the blade: the scene's own stroke would cut the plan.
+            session
+                .hand
+                .take_mouse(0, session.body.solver().params().frame_dt as f64);
+        }
         let mut renderer = Renderer::new(
             &gpu.dev.device,
             &gpu.dev.queue,
@@ -233,8 +264,7 @@ impl Live {
             Some(gpu.dev.limits.max_texture_dimension_2d as usize),
         );
         let home = preview_camera(session.body.solver().mesh());
-        let scene_dir = opts
-            .scene
+        let scene_dir = scene
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
             .unwrap_or(Path::new("."));
@@ -247,7 +277,11 @@ impl Live {
                 overlays: Default::default(),
                 message: String::new(),
                 stroke_file: "out/preview_stroke.ron".into(),
+                exercises: scene_files(&scene_dir.join("exercises")),
+                result_card: None,
+                show_result: false,
             },
+            exercise,
             window,
             gpu,
             session,
@@ -319,8 +353,8 @@ impl Live {
         self.last_frame = now;
         let mut sim_ms = 0.0;
         if self.panel.playing {
-            match self.session.step() {
-                Ok((_, ms)) => sim_ms = ms,
+            match self.step() {
+                Ok(ms) => sim_ms = ms,
                 Err(e) => {
                     self.panel.playing = false;
                     self.panel.message = format!("solver stopped: {e}");
@@ -338,6 +372,20 @@ impl Live {
             device: self.session.body.device(),
             times: &self.times,
             scalpel: ScalpelInfo::of(&self.session.hand),
+            exercise: self.exercise.as_ref().map(|e| {
+                let ex = &e.exercise.exercise;
+                ExerciseInfo {
+                    name: ex.name.clone(),
+                    file: e.exercise.path.clone(),
+                    description: ex.description.clone(),
+                    depth: (ex.depth, ex.tolerance.depth),
+                    lateral: ex.tolerance.lateral,
+                    time_limit: ex.time_limit,
+                    running: e
+                        .running()
+                        .map(|n| n as f64 * solver.params().frame_dt as f64),
+                }
+            }),
         };
         let input = self.egui_winit.take_egui_input(&self.window);
         let panel = &mut self.panel;
@@ -362,6 +410,11 @@ impl Live {
             overlays: self.panel.overlays,
             stress_max: stress_scale(solver),
             tool: crate::tool_view::tool_state(solver),
+            lines: self
+                .exercise
+                .iter()
+                .map(|e| e.decal.line_uncut(solver.positions(), solver.cut().live()))
+                .collect(),
             ..RenderSettings::default()
         };
         let (w, h) = self.gpu.size();
@@ -422,34 +475,145 @@ impl Live {
         Ok(!last)
     }
 
-    fn act(&mut self, action: Action) -> Result<()> {
-        let dev = &self.gpu.dev;
-        let restarts = matches!(action, Action::Load(_) | Action::Reset | Action::Apply(..));
-        if restarts && self.session.hand.abort_recording() {
-            self.panel.message = "recording dropped: the scene changed under it".into();
+    /// Simulate one frame (kept for the exercise attempt under way); its time, ms.
+    fn step(&mut self) -> Result<f64, String> {
+        let (stats, ms) = self.session.step()?;
+        if let Some(e) = &mut self.exercise {
+            e.after_step(&stats);
         }
+        Ok(ms)
+    }
+
+    /// Open the scene at `path` in place of the current one.
+    fn load_scene(&mut self, path: &Path) -> Result<()> {
+        let dev = &self.gpu.dev;
+        let s = Session::load(path, self.session.device, dev)?;
+        self.renderer = Renderer::new(
+            &dev.device,
+            &dev.queue,
+            self.gpu.format(),
+            s.body.solver().mesh(),
+            &s.skin,
+        );
+        self.renderer
+            .set_tool_mesh(&crate::tool_view::tool_mesh(&s.hand.tool));
+        self.home = preview_camera(s.body.solver().mesh());
+        self.camera = self.home;
+        self.panel.draft = s.params;
+        self.session = s;
+        Ok(())
+    }
+
+    /// Open the exercise at `path` and its scene, the mouse holding the blade.
+    fn open_exercise(&mut self, path: &Path) -> Result<String> {
+        let mode = ExerciseMode::open(path)?;
+        self.load_scene(mode.scene_path())?;
+        let dt = self.session.body.solver().params().frame_dt as f64;
+        self.session.hand.take_mouse(0, dt);
+        let name = mode.exercise.exercise.name.clone();
+        self.exercise = Some(mode);
+        Ok(format!(
+            "exercise {name}: cut along the violet line; Start attempt when ready"
+        ))
+    }
+
+    /// Start an attempt at the open exercise from its scene as loaded.
+    fn start_attempt(&mut self, reference: bool) -> Result<String> {
+        let Some(mode) = &mut self.exercise else {
+            bail!("no exercise is open");
+        };
+        let dev = &self.gpu.dev;
+        let stroke = reference.then(|| mode.reference()).transpose()?;
+        self.session.reload(dev)?;
+        let session = &mut self.session;
+        let dt = session.body.solver().params().frame_dt as f64;
+        match stroke {
+            Some(s) => session.hand.play(s),
+            None => session.hand.take_mouse(0, dt),
+        }
+        let pictures = Screenshots::new(
+            Some(dev),
+            session.body.solver(),
+            &session.skin,
+            ATTEMPT_PICTURE,
+            Default::default(),
+        )
+        .map(|s| {
+            s.with_tool(&session.hand.tool)
+                .with_decal(mode.decal.clone())
+                .with_shared_device()
+        })
+        .map_err(|e| format!("no offscreen renderer ({e:#})"));
+        mode.start(&mut session.hand, &mut session.body, pictures)?;
+        self.panel.draft = session.params;
+        self.panel.playing = true;
+        Ok(if reference {
+            "attempt started: the reference stroke cuts; Finish attempt to score it".into()
+        } else {
+            "attempt started: cut along the violet line, then Finish attempt".into()
+        })
+    }
+
+    /// Score and save the attempt under way, and show its card.
+    fn finish_attempt(&mut self) -> Result<String> {
+        let Some(mode) = &mut self.exercise else {
+            bail!("no exercise is open");
+        };
+        let done = mode.finish(
+            &mut self.session.hand,
+            &self.session.body,
+            Path::new(ATTEMPTS_DIR),
+            Path::new(HISTORY_FILE),
+        )?;
+        let card = egui::ColorImage::from_rgba_unmultiplied(
+            [done.card.width as usize, done.card.height as usize],
+            &done.card.pixels,
+        );
+        self.panel.result_card = Some(self.egui.load_texture(
+            "result card",
+            card,
+            egui::TextureOptions::LINEAR,
+        ));
+        self.panel.show_result = true;
+        let r = &done.attempt.result;
+        Ok(format!(
+            "{} score {:.0} / 100: saved {} (report.html); replay: incise exercise {} --stroke {}",
+            if r.verdict.passed { "PASS" } else { "FAIL" },
+            r.verdict.score,
+            done.dir.display(),
+            mode.exercise.path.display(),
+            done.stroke.display()
+        ))
+    }
+
+    fn act(&mut self, action: Action) -> Result<()> {
+        let restarts = matches!(
+            action,
+            Action::Load(_)
+                | Action::Reset
+                | Action::Apply(..)
+                | Action::StartRecording
+                | Action::OpenExercise(_)
+                | Action::StartAttempt { .. }
+        );
+        if restarts {
+            let hand = &mut self.session.hand;
+            if self.exercise.as_mut().is_some_and(|e| e.abort(hand)) {
+                self.panel.message = "attempt abandoned: the scene changed under it".into();
+            } else if !matches!(action, Action::StartRecording) && hand.abort_recording() {
+                self.panel.message = "recording dropped: the scene changed under it".into();
+            }
+        }
+        let dev = &self.gpu.dev;
         let result = match action {
-            Action::Load(path) => Session::load(&path, self.session.device, dev).map(|s| {
-                self.renderer = Renderer::new(
-                    &dev.device,
-                    &dev.queue,
-                    self.gpu.format(),
-                    s.body.solver().mesh(),
-                    &s.skin,
-                );
-                self.renderer
-                    .set_tool_mesh(&crate::tool_view::tool_mesh(&s.hand.tool));
-                self.home = preview_camera(s.body.solver().mesh());
-                self.camera = self.home;
-                self.panel.draft = s.params;
-                self.session = s;
+            Action::Load(path) => self.load_scene(&path).map(|()| {
+                self.exercise = None;
                 "loaded".to_string()
             }),
-            Action::Step => self
-                .session
-                .step()
-                .map(|_| String::new())
-                .map_err(|e| anyhow!(e)),
+            Action::OpenExercise(path) => self.open_exercise(&path),
+            Action::StartAttempt { reference } => self.start_attempt(reference),
+            Action::FinishAttempt => self.finish_attempt(),
+            Action::Step => self.step().map(|_| String::new()).map_err(|e| anyhow!(e)),
             Action::Reset => self.session.reset(dev).map(|()| "reset".into()),
             Action::Apply(params, device) => self
                 .session

@@ -1,7 +1,8 @@
 //! The egui side panel: scene picker, play/pause/step/reset, live material and solver
 //! settings, device, overlays with the stress legend, the frame-time graph, the scalpel
-//! (depth, force, haptic amplitude, stroke recording), and buttons for screenshots and
-//! `.vtu` snapshots. It only reports what the user asked for.
+//! (depth, force, haptic amplitude, stroke recording), the exercise (its task, attempts,
+//! the result card in a "Result" window), and buttons for screenshots and `.vtu`
+//! snapshots. It only reports what the user asked for.
 
 use std::path::PathBuf;
 
@@ -38,6 +39,16 @@ pub enum Action {
     StartRecording,
     /// Stop recording and save the stroke to this file.
     StopRecording(PathBuf),
+    /// Open this exercise (and its scene).
+    OpenExercise(PathBuf),
+    /// Start an attempt at the open exercise from the scene as loaded; `reference`: the
+    /// exercise's reference stroke moves the blade instead of the mouse.
+    StartAttempt {
+        /// Watch the reference stroke instead of cutting.
+        reference: bool,
+    },
+    /// Score and save the attempt under way.
+    FinishAttempt,
 }
 
 /// Panel state that persists between frames.
@@ -56,6 +67,30 @@ pub struct Panel {
     pub message: String,
     /// Where a recorded stroke is saved.
     pub stroke_file: String,
+    /// Exercise files offered.
+    pub exercises: Vec<PathBuf>,
+    /// The last attempt's result card.
+    pub result_card: Option<egui::TextureHandle>,
+    /// Whether the "Result" window is open.
+    pub show_result: bool,
+}
+
+/// What the panel shows of the open exercise.
+pub struct ExerciseInfo {
+    /// Exercise name.
+    pub name: String,
+    /// Its file.
+    pub file: PathBuf,
+    /// The task in words.
+    pub description: String,
+    /// Target depth and allowed depth error, m.
+    pub depth: (f32, f32),
+    /// Half-width of the band around the plan, m.
+    pub lateral: f32,
+    /// Time limit, s.
+    pub time_limit: f32,
+    /// Simulated time of the attempt under way, s.
+    pub running: Option<f64>,
 }
 
 /// What the panel shows of the scalpel.
@@ -112,6 +147,8 @@ pub struct PanelInfo<'a> {
     pub times: &'a FrameTimes,
     /// The scalpel.
     pub scalpel: ScalpelInfo,
+    /// The open exercise, if any.
+    pub exercise: Option<ExerciseInfo>,
 }
 
 impl Panel {
@@ -124,6 +161,8 @@ impl Panel {
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     self.scene_section(ui, info, &mut actions);
+                    ui.separator();
+                    self.exercise_section(ui, info.exercise.as_ref(), &mut actions);
                     ui.separator();
                     self.settings_section(ui, &mut actions);
                     ui.separator();
@@ -152,7 +191,80 @@ impl Panel {
                     ui.small("Left-drag: cut · right-drag: orbit · middle/shift+right-drag: pan · wheel: zoom (depth while cutting or with Ctrl) · R: reset view · F: fullscreen · Space: play");
                 });
             });
+        self.result_window(ui.ctx());
         (actions, shown.response.rect.width())
+    }
+
+    fn exercise_section(
+        &mut self,
+        ui: &mut egui::Ui,
+        ex: Option<&ExerciseInfo>,
+        actions: &mut Vec<Action>,
+    ) {
+        ui.heading("Exercise");
+        let current = ex.map_or("none".to_string(), |e| file_name(&e.file));
+        egui::ComboBox::from_id_salt("exercise")
+            .selected_text(current.clone())
+            .show_ui(ui, |ui| {
+                for f in &self.exercises {
+                    let name = file_name(f);
+                    if ui.selectable_label(name == current, name).clicked() {
+                        actions.push(Action::OpenExercise(f.clone()));
+                    }
+                }
+            });
+        let Some(ex) = ex else {
+            ui.small("Pick an exercise: a planned incision to cut, scored.");
+            return;
+        };
+        ui.label(egui::RichText::new(&ex.name).strong());
+        ui.label(&ex.description);
+        let mm = |v: f32| v * 1e3;
+        ui.small(format!(
+            "depth {:.1} mm ± {:.1} mm · within {:.1} mm of the violet line · {:.0} s",
+            mm(ex.depth.0),
+            mm(ex.depth.1),
+            mm(ex.lateral),
+            ex.time_limit
+        ));
+        match ex.running {
+            None => {
+                ui.horizontal(|ui| {
+                    if ui.button("Start attempt").clicked() {
+                        actions.push(Action::StartAttempt { reference: false });
+                    }
+                    if ui.button("Watch the reference").clicked() {
+                        actions.push(Action::StartAttempt { reference: true });
+                    }
+                });
+            }
+            Some(t) => {
+                ui.horizontal(|ui| {
+                    if ui.button("Finish attempt").clicked() {
+                        actions.push(Action::FinishAttempt);
+                    }
+                    ui.label(format!("attempt: {t:.1} s"));
+                });
+            }
+        }
+        if self.result_card.is_some() && !self.show_result && ui.button("Show result").clicked() {
+            self.show_result = true;
+        }
+    }
+
+    /// The last result card in its own window, while open.
+    fn result_window(&mut self, ctx: &egui::Context) {
+        let Some(card) = &self.result_card else {
+            return;
+        };
+        let size = card.size_vec2() * 0.75;
+        egui::Window::new("Result")
+            .open(&mut self.show_result)
+            .default_pos(egui::pos2(300.0, 40.0))
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.image(egui::load::SizedTexture::new(card.id(), size));
+            });
     }
 
     fn scene_section(

@@ -107,10 +107,16 @@ impl Session {
     /// its own settings, so `incise run SCENE --stroke FILE` replays the same physics) and
     /// the blade keeps its place and mouse state.
     pub fn start_recording(&mut self, dev: &RenderDevice) -> Result<()> {
+        self.reload(dev)?;
+        self.hand.start_recording(&mut self.body)
+    }
+
+    /// Load the scene again as its file says (frame 0, its own settings); the blade keeps
+    /// its place and mouse state.
+    pub fn reload(&mut self, dev: &RenderDevice) -> Result<()> {
         let mut fresh = Session::load(&self.path, self.device, dev)?;
         fresh.hand.input = self.hand.input.clone();
         fresh.hand.play_stroke = self.hand.play_stroke && fresh.hand.has_stroke();
-        fresh.hand.start_recording(&mut fresh.body)?;
         *self = fresh;
         Ok(())
     }

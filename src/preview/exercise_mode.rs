@@ -1,0 +1,214 @@
+//! An exercise in the preview: its plan drawn on the tissue, and attempts — started from
+//! the scene as loaded with the scalpel's poses recorded and every frame's statistics
+//! kept, finished by scoring the live body with the same [`score_attempt`] as `incise
+//! exercise` and saving result.json, report.html, the stroke and the result card. No
+//! window needed: tests drive it with a [`HandTool`] and a [`Body`].
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail};
+use incise_sim::xpbd::FrameStats;
+use incise_xr::RgbaImage;
+
+use super::hand_tool::HandTool;
+use crate::body::Body;
+use crate::exercise::{
+    Attempt, CutImages, LoadedExercise, PlanDecal, ReferenceStyle, Standing, load_exercise,
+    read_history, reference_stroke, render_card, save_attempt, score_attempt,
+};
+use crate::screenshots::Screenshots;
+
+/// An exercise open in the preview.
+pub struct ExerciseMode {
+    /// The exercise, its scene and plan.
+    pub exercise: LoadedExercise,
+    /// The plan as a line on the tissue.
+    pub decal: PlanDecal,
+    attempt: Option<Running>,
+}
+
+/// An attempt under way.
+struct Running {
+    /// Statistics of every frame since the start.
+    stats: Vec<FrameStats>,
+    /// The renderer for the report's pictures and the picture at the start, or why there
+    /// are none.
+    pictures: Result<(Screenshots, RgbaImage), String>,
+}
+
+/// A finished, scored and saved attempt.
+pub struct Finished {
+    /// The result and where result.json and report.html are.
+    pub attempt: Attempt,
+    /// The attempt's folder.
+    pub dir: PathBuf,
+    /// The recorded stroke (replay: `incise exercise EXERCISE --stroke FILE`).
+    pub stroke: PathBuf,
+    /// Where the attempt stands in the history, when the history could be read back.
+    pub standing: Option<Standing>,
+    /// The result card (also saved as card.png).
+    pub card: RgbaImage,
+}
+
+impl ExerciseMode {
+    /// Load the exercise at `path` and lay its plan on the mesh.
+    pub fn open(path: &Path) -> Result<ExerciseMode> {
+        let exercise = load_exercise(path)?;
+        let decal = PlanDecal::new(&exercise.plan, &exercise.mesh);
+        Ok(ExerciseMode {
+            exercise,
+            decal,
+            attempt: None,
+        })
+    }
+
+    /// The exercise's scene file.
+    pub fn scene_path(&self) -> &Path {
+        &self.exercise.scene_path
+    }
+
+    /// The exercise's reference stroke (what a good attempt looks like).
+    pub fn reference(&self) -> Result<incise_scalpel::Stroke> {
+        reference_stroke(&self.exercise, ReferenceStyle::default())
+    }
+
+    /// Start an attempt on `body`, which must be the exercise's scene as loaded (frame 0):
+    /// the scalpel's poses are recorded from now on, and the start is pictured with
+    /// `pictures` (the renderer for the report, or why there is none).
+    pub fn start(
+        &mut self,
+        hand: &mut HandTool,
+        body: &mut Body,
+        pictures: Result<Screenshots, String>,
+    ) -> Result<()> {
+        if body.solver().mesh().tet_count() != self.exercise.mesh.tet_count() {
+            bail!(
+                "the scene running is not {}'s scene {}",
+                self.exercise.exercise.name,
+                self.exercise.scene_path.display()
+            );
+        }
+        hand.abort_recording();
+        hand.start_recording(body)?;
+        let pictures = pictures.and_then(|mut shots| {
+            let before = shots.image(body).map_err(|e| format!("{e:#}"))?;
+            Ok((shots, before))
+        });
+        self.attempt = Some(Running {
+            stats: Vec::new(),
+            pictures,
+        });
+        Ok(())
+    }
+
+    /// Frames simulated in the attempt under way, if one is.
+    pub fn running(&self) -> Option<usize> {
+        self.attempt.as_ref().map(|a| a.stats.len())
+    }
+
+    /// Keep a simulated frame's statistics (nothing without an attempt).
+    pub fn after_step(&mut self, stats: &FrameStats) {
+        if let Some(a) = &mut self.attempt {
+            a.stats.push(stats.clone());
+        }
+    }
+
+    /// Drop the attempt under way (the scene changed under it); whether there was one.
+    pub fn abort(&mut self, hand: &mut HandTool) -> bool {
+        hand.abort_recording();
+        self.attempt.take().is_some()
+    }
+
+    /// Finish the attempt: score `body` as it is now (its released tets and the frames
+    /// kept), and save into a new folder `out_root/<exercise>-<UTC time>/` the recorded
+    /// stroke.ron, result.json, report.html (with pictures of the start and now when a
+    /// renderer was given), and card.png; the attempt is appended to `history`.
+    pub fn finish(
+        &mut self,
+        hand: &mut HandTool,
+        body: &Body,
+        out_root: &Path,
+        history: &Path,
+    ) -> Result<Finished> {
+        let frames = body.solver().frame();
+        let running = self
+            .attempt
+            .as_ref()
+            .ok_or_else(|| anyhow!("no attempt is under way"))?;
+        if frames == 0 || running.stats.len() as u64 != frames {
+            bail!(
+                "the attempt has {} frames of statistics for {frames} simulated frames; start \
+                 it again",
+                running.stats.len()
+            );
+        }
+        if hand.recording().is_none() {
+            bail!("the attempt's stroke recording was stopped; start the attempt again");
+        }
+        let Some(running) = self.attempt.take() else {
+            bail!("no attempt is under way");
+        };
+        let name = &self.exercise.exercise.name;
+        let dir = new_attempt_dir(out_root, name)?;
+        let stroke = dir.join("stroke.ron");
+        hand.stop_recording(&stroke)?;
+        let released: Vec<bool> = body.solver().cut().live().iter().map(|l| !l).collect();
+        let result = score_attempt(
+            &self.exercise,
+            &stroke.display().to_string(),
+            body.device(),
+            &released,
+            &running.stats,
+            frames,
+        )?;
+        let (before, after) = (dir.join("before.png"), dir.join("after.png"));
+        let images = match running.pictures {
+            Ok((mut shots, first)) => match shots.image(body) {
+                Ok(last) => {
+                    first.save_png(&before)?;
+                    last.save_png(&after)?;
+                    CutImages::Files(vec![
+                        ("Before the attempt", before.as_path()),
+                        ("After the attempt", after.as_path()),
+                    ])
+                }
+                Err(e) => CutImages::Missing(format!("{e:#}")),
+            },
+            Err(why) => CutImages::Missing(why),
+        };
+        let attempt = save_attempt(&dir, result, &images, history)?;
+        let standing = read_history(history)
+            .ok()
+            .and_then(|h| Standing::in_history(&h, name));
+        let card = render_card(&attempt.result, standing)?;
+        card.save_png(&dir.join("card.png"))?;
+        Ok(Finished {
+            attempt,
+            dir,
+            stroke,
+            standing,
+            card,
+        })
+    }
+}
+
+/// A new folder `root/<name>-<UTC time, compact>` (`-2`, `-3`, … appended when taken).
+fn new_attempt_dir(root: &Path, name: &str) -> Result<PathBuf> {
+    let stamp: String = crate::exercise::utc_now()
+        .chars()
+        .filter(|c| !matches!(c, '-' | ':'))
+        .collect();
+    std::fs::create_dir_all(root).with_context(|| format!("creating {}", root.display()))?;
+    for k in 1..1000 {
+        let dir = match k {
+            1 => root.join(format!("{name}-{stamp}")),
+            k => root.join(format!("{name}-{stamp}-{k}")),
+        };
+        match std::fs::create_dir(&dir) {
+            Ok(()) => return Ok(dir),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e).with_context(|| format!("creating {}", dir.display())),
+        }
+    }
+    bail!("{}: no free folder name for {name}-{stamp}", root.display())
+}
