@@ -112,6 +112,14 @@ pub enum Command {
         /// Where the solver runs (auto: the headset's GPU; the CPU for a simulated one).
         #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
         device: DeviceChoice,
+        /// Training exercise (e.g. config/exercises/slab_depth.ron): its scene with the plan
+        /// drawn on the tissue; A finishes an attempt (scored, saved under OUT/attempts/,
+        /// the result card shown above the tray), A again starts over.
+        #[arg(long, conflicts_with = "scene")]
+        exercise: Option<PathBuf>,
+        /// Results history exercise attempts are appended to.
+        #[arg(long, default_value = "results/history.jsonl")]
+        history: PathBuf,
     },
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {

@@ -121,6 +121,8 @@ fn main() -> ExitCode {
             record_stroke,
             frames,
             device,
+            exercise,
+            history,
         } => incise::xr::run(&incise::xr::XrOptions {
             scene: scene.unwrap_or_else(|| XR_SCENE.into()),
             simulated: simulated_headset,
@@ -128,6 +130,8 @@ fn main() -> ExitCode {
             record_stroke,
             frames,
             device,
+            exercise,
+            history,
         })
         .map(|r| println!("{}", r.summary())),
         Command::Render {

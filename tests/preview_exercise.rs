@@ -10,7 +10,7 @@ use std::path::Path;
 
 use common::{incise, temp_dir, text};
 use incise::body::Body;
-use incise::preview::exercise_mode::ExerciseMode;
+use incise::exercise::LiveExercise;
 use incise::preview::hand_tool::HandTool;
 use incise::scene::{ToolDriver, build_scene_driven};
 use incise::screenshots::{ImageSize, Screenshots, default_camera};
@@ -26,7 +26,7 @@ fn json(path: &Path) -> Value {
 fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
     let dir = temp_dir("preview-exercise");
     let history = dir.join("history.jsonl");
-    let mut mode = ExerciseMode::open(Path::new(EXERCISE)).unwrap();
+    let mut mode = LiveExercise::open(Path::new(EXERCISE)).unwrap();
     let scene = incise::scene::load_scene(mode.scene_path()).unwrap();
     let mut built = build_scene_driven(&scene, mode.scene_path(), None, ToolDriver::Hand).unwrap();
     let camera = default_camera(built.solver.mesh());

@@ -309,3 +309,166 @@ fn a_lost_or_ending_runtime_stops_the_session_cleanly_and_keeps_its_outputs() {
         );
     }
 }
+
+/// A headset script for the slab_depth exercise: the head 15 cm from the slab looking
+/// down at it, then (1.7–1.9 s) raised to look ahead over the tray; the right controller
+/// draws the exercise's reference stroke from 0.1 s with the trigger held; then `extra`
+/// (buttons, faults, screenshots) — eyes 480 px square, every 12th frame drawn.
+fn exercise_script(duration: f64, extra: &str) -> String {
+    let stroke =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("config/strokes/slab_depth_reference.ron");
+    format!(
+        "(duration: {duration}, eye_size: (480, 480), render_every: 12, pacing: Nominal, \
+         head: [(t: 0.0, position: (0.0, 1.02, -0.36), orientation: (-0.42262, 0.0, 0.0, 0.90631)), \
+                (t: 1.7, position: (0.0, 1.02, -0.36), orientation: (-0.42262, 0.0, 0.0, 0.90631)), \
+                (t: 1.9, position: (0.0, 1.25, -0.05), orientation: (-0.08716, 0.0, 0.0, 0.99619))], \
+         right: Some(Tool(start: 0.1, stroke: File({:?}))), trigger: [(0.0, 1.0)], {extra})",
+        stroke.to_str().unwrap()
+    )
+}
+
+/// Run `incise xr --exercise slab_depth` on `script`; the output folder and xr_report.json.
+fn run_exercise_session(
+    name: &str,
+    script: &str,
+) -> (std::path::PathBuf, Value, std::process::Output) {
+    let dir = temp_dir(name);
+    let path = dir.join("headset.ron");
+    std::fs::write(&path, script).unwrap();
+    let out = dir.join("out");
+    let o = incise(&[
+        "xr",
+        "--exercise",
+        "config/exercises/slab_depth.ron",
+        "--simulated-headset",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--history",
+        dir.join("history.jsonl").to_str().unwrap(),
+    ]);
+    let report = serde_json::from_str(
+        &std::fs::read_to_string(out.join("xr_report.json"))
+            .unwrap_or_else(|e| panic!("no xr_report.json ({e}): {}", text(&o.stderr))),
+    )
+    .unwrap();
+    (out, report, o)
+}
+
+/// Pixels of the result card's paper colour (sRGB 250, 250, 247).
+fn card_pixels(img: &RgbaImage) -> usize {
+    (0..img.height)
+        .flat_map(|y| (0..img.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.get(x, y);
+            (p[0] as i32 - 250).abs() <= 4
+                && (p[1] as i32 - 250).abs() <= 4
+                && (p[2] as i32 - 247).abs() <= 4
+        })
+        .count()
+}
+
+/// Issue 10 in the headset: the plan is drawn on the tissue, A finishes the attempt
+/// (scored as `incise exercise` scores its recorded stroke, saved, appended to the
+/// history) and hangs the result card above the tray.
+#[test]
+fn an_exercise_in_the_headset_is_scored_on_a_and_shows_its_card() {
+    // Stroke 0.1–1.37 s; A at 1.8 s; eyes saved at frames 36 (0.5 s: the line is still
+    // mostly uncut) and 144 (2.0 s).
+    let (out, r, o) = run_exercise_session(
+        "xr-exercise",
+        &exercise_script(2.2, "buttons: [(1.8, A)], screenshots: [36, 144]"),
+    );
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(r["exit"], "Exited", "{r}");
+    let attempts = r["attempts"].as_array().unwrap();
+    assert_eq!(attempts.len(), 1, "{r}");
+    let a = &attempts[0];
+    assert_eq!(a["ended_by"], "A pressed");
+    assert_eq!(a["passed"], true, "{a}: {err}");
+    let dir = std::path::PathBuf::from(a["dir"].as_str().unwrap());
+    for f in ["result.json", "report.html", "stroke.ron", "card.png"] {
+        assert!(dir.join(f).exists(), "{f} missing in {}", dir.display());
+    }
+    let history = std::fs::read_to_string(out.parent().unwrap().join("history.jsonl")).unwrap();
+    assert_eq!(history.lines().count(), 1);
+
+    // The plan is drawn while cutting (violet ink, sRGB #6A1B9A-ish) and the card only
+    // after A.
+    let before = RgbaImage::load_png(&out.join("eye_left_00036.png")).unwrap();
+    let after = RgbaImage::load_png(&out.join("eye_left_00144.png")).unwrap();
+    let violet = |img: &RgbaImage| {
+        (0..img.height)
+            .flat_map(|y| (0..img.width).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                let p = img.get(x, y);
+                p[2] > 100 && p[0] > 60 && p[1] < 60 && p[2] > p[0]
+            })
+            .count()
+    };
+    assert!(
+        violet(&before) > 5,
+        "plan drawn: {} violet pixels",
+        violet(&before)
+    );
+    assert!(
+        card_pixels(&before) < 20,
+        "no card before A: {}",
+        card_pixels(&before)
+    );
+    assert!(
+        card_pixels(&after) > 500,
+        "card after A: {}",
+        card_pixels(&after)
+    );
+    for eye in ["left", "right"] {
+        let img = RgbaImage::load_png(&out.join(format!("eye_{eye}_00144.png"))).unwrap();
+        assert!(card_pixels(&img) > 500, "{eye} eye sees the card");
+    }
+
+    // The live score is what `incise exercise` gives the attempt's recorded stroke.
+    let live: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap();
+    let replay = out.join("replay");
+    let o = incise(&[
+        "exercise",
+        "config/exercises/slab_depth.ron",
+        "--stroke",
+        dir.join("stroke.ron").to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--quiet",
+        "--out",
+        replay.to_str().unwrap(),
+        "--history",
+        out.join("replay_history.jsonl").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let replayed: Value =
+        serde_json::from_str(&std::fs::read_to_string(replay.join("result.json")).unwrap())
+            .unwrap();
+    let (s1, s2) = (
+        live["verdict"]["score"].as_f64().unwrap(),
+        replayed["verdict"]["score"].as_f64().unwrap(),
+    );
+    assert!((s1 - s2).abs() < 2.0, "live {s1} vs replay {s2}");
+    assert_eq!(replayed["verdict"]["passed"], true);
+}
+
+/// Issue 10 and 11: an attempt under way when the session is lost is still scored and
+/// saved.
+#[test]
+fn an_attempt_under_way_is_saved_when_the_session_is_lost() {
+    let (_, r, o) = run_exercise_session(
+        "xr-exercise-lost",
+        &exercise_script(3.0, "faults: [(1.6, SessionLoss)]"),
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(r["exit"], "SessionLost", "{r}");
+    let attempts = r["attempts"].as_array().unwrap();
+    assert_eq!(attempts.len(), 1, "{r}");
+    assert_eq!(attempts[0]["ended_by"], "session ended");
+    let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
+    assert!(dir.join("result.json").exists());
+}

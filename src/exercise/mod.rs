@@ -6,6 +6,7 @@
 mod attempt;
 mod decal;
 mod history;
+mod live;
 mod load;
 mod metrics;
 mod model;
@@ -22,6 +23,7 @@ pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, PlanDecal};
 pub use history::{
     HistoryEntry, append as append_history, read as read_history, table as history_table, utc_now,
 };
+pub use live::{Finished, LiveExercise, StrokeSource};
 pub use load::{LoadedExercise, load_exercise, parse_exercise};
 pub use metrics::{Metrics, STROKE_GAP_FRAMES, compute as compute_metrics};
 pub use model::{Exercise, PassThresholds, Tolerance};

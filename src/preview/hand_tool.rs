@@ -188,3 +188,21 @@ impl HandTool {
         self.amplitude = self.haptic.amplitude(self.force);
     }
 }
+
+impl crate::exercise::StrokeSource for HandTool {
+    fn start_recording(&mut self, body: &mut Body) -> Result<()> {
+        HandTool::start_recording(self, body)
+    }
+
+    fn is_recording(&self) -> bool {
+        self.recording().is_some()
+    }
+
+    fn save_recording(&mut self, path: &Path) -> Result<()> {
+        self.stop_recording(path).map(|_| ())
+    }
+
+    fn abort_recording(&mut self) {
+        HandTool::abort_recording(self);
+    }
+}

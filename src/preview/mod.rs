@@ -2,12 +2,11 @@
 //! side panel, orbit/pan/zoom and the mouse scalpel (left-drag cuts, see
 //! [`scalpel_input`]). `--frames N` renders N frames and exits (for tests and scripts);
 //! `--screenshot FILE` saves the window's last frame (also when Escape closes it).
-//! `--exercise FILE` opens an exercise ([`exercise_mode`]): its plan drawn on the tissue,
+//! `--exercise FILE` opens an exercise ([`LiveExercise`]): its plan drawn on the tissue,
 //! attempts scored live and saved.
 
 mod camera_input;
 pub mod display;
-pub mod exercise_mode;
 mod frame_times;
 pub mod hand_tool;
 mod panel;
@@ -36,8 +35,8 @@ fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
     cam.zoom(1.3);
     cam
 }
+use crate::exercise::LiveExercise;
 use camera_input::{CameraInput, KeyAction, wheel_steps};
-use exercise_mode::ExerciseMode;
 use frame_times::{FrameTime, FrameTimes};
 use panel::{Action, ExerciseInfo, Panel, PanelInfo, ScalpelInfo};
 use session::{Session, scene_files};
@@ -119,7 +118,7 @@ struct Live {
     /// Escape was pressed: the next frame is the last.
     quitting: bool,
     /// The open exercise.
-    exercise: Option<ExerciseMode>,
+    exercise: Option<LiveExercise>,
 }
 
 impl ApplicationHandler for App {
@@ -234,7 +233,7 @@ impl Live {
         let exercise = opts
             .exercise
             .as_deref()
-            .map(ExerciseMode::open)
+            .map(LiveExercise::open)
             .transpose()?;
         let scene = exercise
             .as_ref()
@@ -506,7 +505,7 @@ impl Live {
 
     /// Open the exercise at `path` and its scene, the mouse holding the blade.
     fn open_exercise(&mut self, path: &Path) -> Result<String> {
-        let mode = ExerciseMode::open(path)?;
+        let mode = LiveExercise::open(path)?;
         self.load_scene(mode.scene_path())?;
         let dt = self.session.body.solver().params().frame_dt as f64;
         self.session.hand.take_mouse(0, dt);

@@ -20,6 +20,7 @@ use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{FrameEvent, Headset, XrError};
 use incise_xr::{BodyState, RenderSettings, Renderer};
 
+use super::exercise::XrExercise;
 use super::frame_log::{FrameLog, FrameRow};
 use super::xr_body::XrBody;
 use crate::screenshots::stress_scale;
@@ -85,6 +86,7 @@ pub fn run_loop(
     xr: &mut XrBody,
     skin: &Skin,
     opts: &LoopOptions<'_>,
+    mut exercise: Option<&mut XrExercise>,
 ) -> Result<LoopOutcome> {
     let dev = headset.device().clone();
     let mut renderer = Renderer::new(
@@ -133,6 +135,9 @@ pub fn run_loop(
     // Every frame runs inside this closure so that a failure mid-frame still ends with
     // the stroke, the frame log and the report saved.
     let mut session = || -> Result<()> {
+        if let Some(ex) = exercise.as_deref_mut() {
+            ex.start(xr, skin, &dev)?;
+        }
         loop {
             let frame = match headset.next_frame()? {
                 FrameEvent::Ended(why) => {
@@ -154,7 +159,18 @@ pub fn run_loop(
             let cmd = commands(&previous, &c);
             previous = c;
             if cmd.reset {
-                xr.reset()?;
+                // In an exercise, A first finishes an attempt the blade has touched (the
+                // result card appears); otherwise it starts the scene over.
+                let reset = match exercise.as_deref_mut() {
+                    Some(ex) => ex.on_a(xr)?,
+                    None => true,
+                };
+                if reset {
+                    xr.reset()?;
+                    if let Some(ex) = exercise.as_deref_mut() {
+                        ex.start(xr, skin, &dev)?;
+                    }
+                }
             }
             stress ^= cmd.toggle_stress;
             paused ^= cmd.toggle_pause;
@@ -185,10 +201,17 @@ pub fn run_loop(
                         eprintln!("xr: {e:#}; resetting the scene");
                         out.solver_resets += 1;
                         xr.reset()?;
+                        if let Some(ex) = exercise.as_deref_mut() {
+                            ex.abort();
+                            ex.start(xr, skin, &dev)?;
+                        }
                         break;
                     }
                 };
                 sim_time += sim_dt;
+                if let Some(ex) = exercise.as_deref_mut() {
+                    ex.after_step(&stats, tool_pose, sim_dt)?;
+                }
                 force = force.max(stats.tool_force.length());
                 if let (true, Some(p)) = (opts.record, tool_pose) {
                     recorder.push(sim_time, p)?;
@@ -216,10 +239,20 @@ pub fn run_loop(
                 let views = frame
                     .eyes
                     .map(|(pose, fov)| eye_view(pose, fov, stage_from_sim));
-                let solver = xr.solver();
-                let pinned = pinned_nodes(solver);
+                let pinned = pinned_nodes(xr.solver());
                 let (pose, tracked) = xr.tool();
+                // The plan on the tissue and the result card above the tray.
+                let (lines, panel) = match exercise.as_deref_mut() {
+                    Some(ex) => {
+                        let head = (frame.eyes[0].0.position + frame.eyes[1].0.position) * 0.5;
+                        (ex.lines(xr), ex.panel(&mut renderer, &dev, &tray, head)?)
+                    }
+                    None => (Vec::new(), None),
+                };
+                let solver = xr.solver();
                 let settings = RenderSettings {
+                    lines,
+                    panel,
                     stress_max: stress_scale(solver),
                     tool: ToolState {
                         transform: tracked
@@ -278,7 +311,21 @@ pub fn run_loop(
         Ok(())
     };
 
-    if let Err(e) = session() {
+    let ended = session();
+    // An attempt the blade touched is scored and saved however the session ended.
+    let saved = match exercise {
+        Some(ex) => ex.end_session(xr),
+        None => Ok(()),
+    };
+    let ended = match (ended, saved) {
+        (Ok(()), saved) => saved,
+        (Err(e), Ok(())) => Err(e),
+        (Err(e), Err(s)) => {
+            eprintln!("xr: saving the attempt failed: {s:#}");
+            Err(e)
+        }
+    };
+    if let Err(e) = ended {
         match e.downcast_ref::<XrError>().and_then(XrError::lost) {
             // The runtime lost the session or is going away: a clean end, as on the
             // LOSS_PENDING event.

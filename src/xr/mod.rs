@@ -2,6 +2,7 @@
 //! (issue 7). With `--simulated-headset SCRIPT.ron` the same frame loop runs without a
 //! runtime on a scripted headset, rendering both eyes offscreen.
 
+pub mod exercise;
 pub mod frame_log;
 pub mod frame_loop;
 pub mod script;
@@ -20,6 +21,7 @@ use incise_xr::openxr::{Headset, XrSession};
 use serde::Serialize;
 
 use crate::body::DeviceChoice;
+use exercise::{AttemptSummary, XrExercise};
 use frame_loop::{LoopOptions, LoopOutcome, run_loop};
 use script::{HeadsetScript, Pacing, RightTrack};
 use simulated::SimulatedHeadset;
@@ -42,6 +44,11 @@ pub struct XrOptions {
     pub frames: Option<u64>,
     /// Where the solver runs.
     pub device: DeviceChoice,
+    /// Run this training exercise (its scene instead of `scene`): the plan drawn on the
+    /// tissue, attempts scored and saved under `out/attempts/`.
+    pub exercise: Option<PathBuf>,
+    /// Results history exercise attempts are appended to.
+    pub history: PathBuf,
 }
 
 /// The session summary written as `xr_report.json`.
@@ -77,25 +84,46 @@ pub struct XrReport {
     pub exit: String,
     /// The recorded stroke, if any.
     pub stroke: Option<String>,
+    /// The exercise file, in an exercise session.
+    pub exercise: Option<String>,
+    /// The exercise attempts finished and saved in the session.
+    pub attempts: Vec<AttemptSummary>,
 }
 
 /// Run `incise xr`. No usable runtime: an [`XrUnavailable`] error (exit 2).
 pub fn run(opts: &XrOptions) -> Result<XrReport> {
+    let mut exercise = opts
+        .exercise
+        .as_ref()
+        .map(|p| XrExercise::open(p, &opts.out.join("attempts"), &opts.history))
+        .transpose()?;
+    let scene = match &exercise {
+        Some(e) => e.exercise().scene_path.clone(),
+        None => opts.scene.clone(),
+    };
     match &opts.simulated {
-        Some(script) => run_simulated(opts, script),
+        Some(script) => run_simulated(opts, &scene, script, exercise.as_mut()),
         None => {
             let mut session = XrSession::open().map_err(|e| {
                 if e.is_unavailable() {
-                    anyhow::Error::new(XrUnavailable(unavailable::message(&e, &opts.scene)))
+                    anyhow::Error::new(XrUnavailable(unavailable::message(&e, &scene)))
                 } else {
                     anyhow::Error::new(e).context("starting the OpenXR session")
                 }
             })?;
             eprintln!("xr: backdrop {:?}", session.backdrop());
             let dev = session.device().clone();
-            let (mut xr, skin) = XrBody::load(&opts.scene, opts.device, &dev)?;
+            let (mut xr, skin) = XrBody::load(&scene, opts.device, &dev)?;
             let tray = tray_for(&xr);
-            run_session(&mut session, &mut xr, &skin, opts, tray, false)
+            run_session(
+                &mut session,
+                &mut xr,
+                &skin,
+                opts,
+                tray,
+                false,
+                exercise.as_mut(),
+            )
         }
     }
 }
@@ -105,14 +133,19 @@ fn tray_for(xr: &XrBody) -> Tray {
     Tray::for_bounds(lo, hi)
 }
 
-fn run_simulated(opts: &XrOptions, script_path: &Path) -> Result<XrReport> {
+fn run_simulated(
+    opts: &XrOptions,
+    scene: &Path,
+    script_path: &Path,
+    exercise: Option<&mut XrExercise>,
+) -> Result<XrReport> {
     let script = HeadsetScript::load(script_path)?;
     let dev = RenderDevice::headless()?;
     let device = match opts.device {
         DeviceChoice::Auto => DeviceChoice::Cpu,
         d => d,
     };
-    let (mut xr, skin) = XrBody::load(&opts.scene, device, &dev)?;
+    let (mut xr, skin) = XrBody::load(scene, device, &dev)?;
     let tray = tray_for(&xr);
     let stroke = match &script.right {
         Some(RightTrack::Tool { stroke, .. }) => Some(match stroke {
@@ -129,7 +162,7 @@ fn run_simulated(opts: &XrOptions, script_path: &Path) -> Result<XrReport> {
     let nominal = script.pacing == Pacing::Nominal;
     let mut headset =
         SimulatedHeadset::new(script, stroke, tray, BladeOffset::default(), dev, &opts.out)?;
-    run_session(&mut headset, &mut xr, &skin, opts, tray, nominal)
+    run_session(&mut headset, &mut xr, &skin, opts, tray, nominal, exercise)
 }
 
 fn run_session(
@@ -139,6 +172,7 @@ fn run_session(
     opts: &XrOptions,
     tray: Tray,
     nominal_pacing: bool,
+    mut exercise: Option<&mut XrExercise>,
 ) -> Result<XrReport> {
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("creating {}", opts.out.display()))?;
@@ -158,6 +192,7 @@ fn run_session(
             record: true,
             tray,
         },
+        exercise.as_deref_mut(),
     )?;
     outcome.log.save(&opts.out.join("frames.csv"))?;
     let mut stroke_path = None;
@@ -190,6 +225,8 @@ fn run_session(
             (None, None) => "the runtime never made the session ready".into(),
         },
         stroke: stroke_path,
+        exercise: opts.exercise.as_ref().map(|p| p.display().to_string()),
+        attempts: exercise.map(|e| e.attempts.clone()).unwrap_or_default(),
     };
     let json = serde_json::to_string_pretty(&report)?;
     let path = opts.out.join("xr_report.json");

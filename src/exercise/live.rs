@@ -1,8 +1,9 @@
-//! An exercise in the preview: its plan drawn on the tissue, and attempts — started from
-//! the scene as loaded with the scalpel's poses recorded and every frame's statistics
-//! kept, finished by scoring the live body with the same [`score_attempt`] as `incise
-//! exercise` and saving result.json, report.html, the stroke and the result card. No
-//! window needed: tests drive it with a [`HandTool`] and a [`Body`].
+//! An exercise attempted on a live body, in the preview or the headset: its plan drawn on
+//! the tissue, and attempts — started from the scene as loaded with the scalpel's poses
+//! recorded (by a [`StrokeSource`]: the preview's mouse blade, the right controller) and
+//! every frame's statistics kept, finished by scoring the live body with the same
+//! [`score_attempt`] as `incise exercise` and saving result.json, report.html, the stroke
+//! and the result card. No window needed: tests drive it with a source and a [`Body`].
 
 use std::path::{Path, PathBuf};
 
@@ -10,16 +11,28 @@ use anyhow::{Context, Result, anyhow, bail};
 use incise_sim::xpbd::FrameStats;
 use incise_xr::RgbaImage;
 
-use super::hand_tool::HandTool;
-use crate::body::Body;
-use crate::exercise::{
+use super::{
     Attempt, CutImages, LoadedExercise, PlanDecal, ReferenceStyle, Standing, load_exercise,
     read_history, reference_stroke, render_card, save_attempt, score_attempt,
 };
+use crate::body::Body;
 use crate::screenshots::Screenshots;
 
-/// An exercise open in the preview.
-pub struct ExerciseMode {
+/// Where a live attempt's scalpel path is recorded: the preview's hand tool, the XR
+/// mode's controller.
+pub trait StrokeSource {
+    /// Start recording on `body`, which is at frame 0.
+    fn start_recording(&mut self, body: &mut Body) -> Result<()>;
+    /// Whether a recording is running.
+    fn is_recording(&self) -> bool;
+    /// Stop recording and write the stroke to `path` atomically.
+    fn save_recording(&mut self, path: &Path) -> Result<()>;
+    /// Drop a running recording without saving it.
+    fn abort_recording(&mut self);
+}
+
+/// An exercise open on a live body.
+pub struct LiveExercise {
     /// The exercise, its scene and plan.
     pub exercise: LoadedExercise,
     /// The plan as a line on the tissue.
@@ -50,12 +63,12 @@ pub struct Finished {
     pub card: RgbaImage,
 }
 
-impl ExerciseMode {
+impl LiveExercise {
     /// Load the exercise at `path` and lay its plan on the mesh.
-    pub fn open(path: &Path) -> Result<ExerciseMode> {
+    pub fn open(path: &Path) -> Result<LiveExercise> {
         let exercise = load_exercise(path)?;
         let decal = PlanDecal::new(&exercise.plan, &exercise.mesh);
-        Ok(ExerciseMode {
+        Ok(LiveExercise {
             exercise,
             decal,
             attempt: None,
@@ -77,7 +90,7 @@ impl ExerciseMode {
     /// `pictures` (the renderer for the report, or why there is none).
     pub fn start(
         &mut self,
-        hand: &mut HandTool,
+        hand: &mut dyn StrokeSource,
         body: &mut Body,
         pictures: Result<Screenshots, String>,
     ) -> Result<()> {
@@ -101,6 +114,13 @@ impl ExerciseMode {
         Ok(())
     }
 
+    /// Whether the blade has touched the tissue in the attempt under way.
+    pub fn touched(&self) -> bool {
+        self.attempt
+            .as_ref()
+            .is_some_and(|a| a.stats.iter().any(|s| s.contact_nodes > 0))
+    }
+
     /// Frames simulated in the attempt under way, if one is.
     pub fn running(&self) -> Option<usize> {
         self.attempt.as_ref().map(|a| a.stats.len())
@@ -114,7 +134,7 @@ impl ExerciseMode {
     }
 
     /// Drop the attempt under way (the scene changed under it); whether there was one.
-    pub fn abort(&mut self, hand: &mut HandTool) -> bool {
+    pub fn abort(&mut self, hand: &mut dyn StrokeSource) -> bool {
         hand.abort_recording();
         self.attempt.take().is_some()
     }
@@ -125,24 +145,23 @@ impl ExerciseMode {
     /// renderer was given), and card.png; the attempt is appended to `history`.
     pub fn finish(
         &mut self,
-        hand: &mut HandTool,
+        hand: &mut dyn StrokeSource,
         body: &Body,
         out_root: &Path,
         history: &Path,
     ) -> Result<Finished> {
-        let frames = body.solver().frame();
         let running = self
             .attempt
             .as_ref()
             .ok_or_else(|| anyhow!("no attempt is under way"))?;
-        if frames == 0 || running.stats.len() as u64 != frames {
-            bail!(
-                "the attempt has {} frames of statistics for {frames} simulated frames; start \
-                 it again",
-                running.stats.len()
-            );
+        // The frames of the attempt are those whose statistics were kept (the XR mode
+        // rebuilds its solver when it changes substeps, which restarts the solver's own
+        // frame count).
+        let frames = running.stats.len() as u64;
+        if frames == 0 {
+            bail!("the attempt has not simulated a frame yet");
         }
-        if hand.recording().is_none() {
+        if !hand.is_recording() {
             bail!("the attempt's stroke recording was stopped; start the attempt again");
         }
         let Some(running) = self.attempt.take() else {
@@ -151,7 +170,7 @@ impl ExerciseMode {
         let name = &self.exercise.exercise.name;
         let dir = new_attempt_dir(out_root, name)?;
         let stroke = dir.join("stroke.ron");
-        hand.stop_recording(&stroke)?;
+        hand.save_recording(&stroke)?;
         let released: Vec<bool> = body.solver().cut().live().iter().map(|l| !l).collect();
         let result = score_attempt(
             &self.exercise,

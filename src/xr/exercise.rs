@@ -1,0 +1,238 @@
+//! An exercise in the headset (issue 10): the plan drawn on the tissue in both eyes, the
+//! attempt recorded from the right controller from the scene as loaded, finished with A
+//! (scored like `incise exercise`, saved with its stroke, report and card, and the result
+//! card hung above the tray); A again starts a new attempt on a fresh scene. An attempt
+//! in which the blade touched the tissue is also finished and saved when the session
+//! ends, however it ends.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use glam::{Mat4, Vec3};
+use incise_scalpel::StrokeRecorder;
+use incise_sim::contact::ToolPose;
+use incise_sim::skin::Skin;
+use incise_sim::xpbd::FrameStats;
+use incise_xr::openxr::result_panel::panel_transform;
+use incise_xr::openxr::tray::Tray;
+use incise_xr::{RenderDevice, Renderer, RgbaImage, SurfaceLine};
+use serde::Serialize;
+
+use super::xr_body::XrBody;
+use crate::body::Body;
+use crate::exercise::{DECAL_COLOUR, DECAL_WIDTH, LiveExercise, LoadedExercise, StrokeSource};
+use crate::screenshots::{ImageSize, Screenshots};
+
+/// Size of the report's before/after pictures, pixels.
+const PICTURE: ImageSize = ImageSize(960, 540);
+
+/// What became of one attempt in the session (in `xr_report.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct AttemptSummary {
+    /// The attempt's folder (result.json, report.html, stroke.ron, card.png).
+    pub dir: String,
+    /// Overall score, 0..100.
+    pub score: f64,
+    /// Whether every pass condition held.
+    pub passed: bool,
+    /// Why it ended: "A pressed" or "session ended".
+    pub ended_by: String,
+}
+
+/// The right controller's path during an attempt, timed by simulated frames since the
+/// attempt's start (so `incise exercise --stroke` replays it on the scene as loaded).
+#[derive(Default)]
+struct ControllerStroke {
+    recorder: Option<StrokeRecorder>,
+}
+
+impl StrokeSource for ControllerStroke {
+    fn start_recording(&mut self, body: &mut Body) -> Result<()> {
+        if body.solver().frame() != 0 {
+            bail!("an attempt starts from the scene as loaded (frame 0)");
+        }
+        self.recorder = Some(StrokeRecorder::new());
+        Ok(())
+    }
+
+    fn is_recording(&self) -> bool {
+        self.recorder.is_some()
+    }
+
+    fn save_recording(&mut self, path: &Path) -> Result<()> {
+        let Some(r) = self.recorder.take() else {
+            bail!("not recording");
+        };
+        r.finish()?.save(path)?;
+        Ok(())
+    }
+
+    fn abort_recording(&mut self) {
+        self.recorder = None;
+    }
+}
+
+/// The exercise state of an XR session.
+pub struct XrExercise {
+    live: LiveExercise,
+    stroke: ControllerStroke,
+    /// Simulated frames of the attempt under way (the stroke's clock).
+    frames: u64,
+    out_root: PathBuf,
+    history: PathBuf,
+    /// The card on show.
+    card: Option<RgbaImage>,
+    /// Whether the renderer's panel image must be replaced (by the card, or removed).
+    card_changed: bool,
+    /// Attempts finished in this session.
+    pub attempts: Vec<AttemptSummary>,
+}
+
+impl XrExercise {
+    /// Open the exercise at `path`; attempts are saved under `out_root` and appended to
+    /// `history`.
+    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<XrExercise> {
+        Ok(XrExercise {
+            live: LiveExercise::open(path)?,
+            stroke: ControllerStroke::default(),
+            frames: 0,
+            out_root: out_root.to_path_buf(),
+            history: history.to_path_buf(),
+            card: None,
+            card_changed: false,
+            attempts: Vec::new(),
+        })
+    }
+
+    /// The exercise (its scene file is what the session loads).
+    pub fn exercise(&self) -> &LoadedExercise {
+        &self.live.exercise
+    }
+
+    /// Start an attempt on `xr`, which is at its scene as loaded; pictures of the report
+    /// are rendered on `dev`.
+    pub fn start(&mut self, xr: &mut XrBody, skin: &Skin, dev: &RenderDevice) -> Result<()> {
+        self.card_changed |= self.card.take().is_some();
+        self.frames = 0;
+        let pictures = Screenshots::new(Some(dev), xr.solver(), skin, PICTURE, Default::default())
+            .map(|s| {
+                let s = s
+                    .with_tool(xr.scalpel())
+                    .with_decal(self.live.decal.clone());
+                match xr.body {
+                    Body::Gpu(_) => s.with_shared_device(),
+                    Body::Cpu(_) => s,
+                }
+            })
+            .map_err(|e| format!("{e:#}"));
+        self.live.start(&mut self.stroke, &mut xr.body, pictures)
+    }
+
+    /// After a simulated frame: keep its statistics and the scalpel's pose (when the
+    /// controller is tracked).
+    pub fn after_step(
+        &mut self,
+        stats: &FrameStats,
+        pose: Option<ToolPose>,
+        dt: f64,
+    ) -> Result<()> {
+        if self.live.running().is_none() {
+            return Ok(());
+        }
+        self.frames += 1;
+        self.live.after_step(stats);
+        if let (Some(r), Some(p)) = (&mut self.stroke.recorder, pose) {
+            r.push(self.frames as f64 * dt, p)?;
+        }
+        Ok(())
+    }
+
+    /// A pressed. With an attempt in which the blade touched the tissue: finish it (the
+    /// card is shown; returns false: keep the scene). Otherwise: returns true, the caller
+    /// resets the scene and calls [`XrExercise::start`].
+    pub fn on_a(&mut self, xr: &XrBody) -> Result<bool> {
+        if self.live.touched() {
+            self.finish(xr, "A pressed")?;
+            Ok(false)
+        } else {
+            self.live.abort(&mut self.stroke);
+            Ok(true)
+        }
+    }
+
+    /// The session is over: finish an attempt in which the blade touched the tissue.
+    pub fn end_session(&mut self, xr: &XrBody) -> Result<()> {
+        if self.live.touched() {
+            self.finish(xr, "session ended")?;
+        }
+        Ok(())
+    }
+
+    /// The solver failed and the scene is being reset: the attempt is lost.
+    pub fn abort(&mut self) {
+        self.live.abort(&mut self.stroke);
+    }
+
+    fn finish(&mut self, xr: &XrBody, why: &str) -> Result<()> {
+        if self.stroke.recorder.as_ref().is_none_or(|r| r.is_empty()) {
+            // The blade touched with no tracked pose recorded (cannot happen while the
+            // tool follows the controller); nothing to replay: drop it.
+            self.live.abort(&mut self.stroke);
+            bail!("the attempt has no recorded scalpel poses");
+        }
+        let done = self
+            .live
+            .finish(&mut self.stroke, &xr.body, &self.out_root, &self.history)?;
+        eprintln!(
+            "xr: {} — {} ({})",
+            done.attempt.result.summary(),
+            done.dir.display(),
+            why
+        );
+        self.attempts.push(AttemptSummary {
+            dir: done.dir.display().to_string(),
+            score: done.attempt.result.verdict.score,
+            passed: done.attempt.result.verdict.passed,
+            ended_by: why.to_string(),
+        });
+        self.card = Some(done.card);
+        self.card_changed = true;
+        Ok(())
+    }
+
+    /// The plan on the tissue as it is now (where not cut away).
+    pub fn lines(&self, xr: &XrBody) -> Vec<SurfaceLine> {
+        let s = xr.solver();
+        let d = self.live.decal.line_uncut(s.positions(), s.cut().live());
+        vec![SurfaceLine {
+            points: d.points,
+            normals: d.normals,
+            width: DECAL_WIDTH,
+            colour: DECAL_COLOUR,
+        }]
+    }
+
+    /// The card's placement (sim world) for a head at `head` (stage), uploading the card
+    /// to `renderer` the first time; `None` while no card is shown.
+    pub fn panel(
+        &mut self,
+        renderer: &mut Renderer,
+        dev: &RenderDevice,
+        tray: &Tray,
+        head: Vec3,
+    ) -> Result<Option<Mat4>> {
+        if self.card_changed {
+            let image = self
+                .card
+                .as_ref()
+                .map(|c| (c.pixels.as_slice(), c.width, c.height));
+            renderer.set_panel_image(&dev.device, &dev.queue, image)?;
+            self.card_changed = false;
+        }
+        let Some(card) = &self.card else {
+            return Ok(None);
+        };
+        let aspect = card.height as f32 / card.width.max(1) as f32;
+        Ok(Some(panel_transform(tray, head, aspect)))
+    }
+}
