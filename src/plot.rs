@@ -100,6 +100,22 @@ pub fn register_fonts() {
     });
 }
 
+/// Write an RGB8 drawing as a PNG, atomically (a killed process leaves the old file or
+/// none, never half a PNG).
+fn save_rgb(path: &Path, rgb: &[u8], (width, height): (u32, u32)) -> Result<(), PlotError> {
+    let image = incise_xr::RgbaImage {
+        width,
+        height,
+        pixels: rgb
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect(),
+    };
+    image
+        .save_png(path)
+        .map_err(|e| draw_err(path)(e.to_string()))
+}
+
 fn draw_err(path: &Path) -> impl Fn(String) -> PlotError + '_ {
     move |message| PlotError::Draw {
         path: path.display().to_string(),
@@ -146,40 +162,46 @@ pub fn write_line_chart(
     let (x0, x1) = range(path, points().map(|p| p.0))?;
     let (y0, y1) = range(path, points().map(|p| p.1))?;
     let err = draw_err(path);
-    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    let mut ctx = ChartBuilder::on(&root)
-        .caption(&chart.title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(|e| err(e.to_string()))?;
-    ctx.configure_mesh()
-        .x_desc(&chart.x_label)
-        .y_desc(&chart.y_label)
-        .label_style(("sans-serif", 15))
-        .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(|e| err(e.to_string()))?;
-    for (i, s) in chart.series.iter().enumerate() {
-        let colour = PALETTE[i % PALETTE.len()];
-        ctx.draw_series(LineSeries::new(
-            s.points.iter().copied(),
-            colour.stroke_width(2),
-        ))
-        .map_err(|e| err(e.to_string()))?
-        .label(&s.name)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+    let mut rgb = vec![0u8; (width * height * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+        let mut ctx = ChartBuilder::on(&root)
+            .caption(&chart.title, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| err(e.to_string()))?;
+        ctx.configure_mesh()
+            .x_desc(&chart.x_label)
+            .y_desc(&chart.y_label)
+            .label_style(("sans-serif", 15))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(|e| err(e.to_string()))?;
+        for (i, s) in chart.series.iter().enumerate() {
+            let colour = PALETTE[i % PALETTE.len()];
+            ctx.draw_series(LineSeries::new(
+                s.points.iter().copied(),
+                colour.stroke_width(2),
+            ))
+            .map_err(|e| err(e.to_string()))?
+            .label(&s.name)
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+            });
+        }
+        ctx.configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 15))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| err(e.to_string()))?;
+        root.present().map_err(|e| err(e.to_string()))?;
     }
-    ctx.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| err(e.to_string()))?;
-    root.present().map_err(|e| err(e.to_string()))
+    save_rgb(path, &rgb, (width, height))
 }
 
 /// Write `panels` as a grid of `columns` panels, each `panel_width` × `panel_height`
@@ -212,51 +234,55 @@ pub fn write_segment_panels(
     (y0, y1) = (cy - 0.5 * scale * plot_h, cy + 0.5 * scale * plot_h);
     let err = draw_err(path);
     let size = (panel_width * columns as u32, panel_height * rows as u32);
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
-    for (area, panel) in root.split_evenly((rows, columns)).iter().zip(panels) {
-        let mut ctx = ChartBuilder::on(area)
-            .caption(&panel.title, ("sans-serif", 18))
-            .margin(8)
-            .x_label_area_size(35)
-            .y_label_area_size(55)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| err(e.to_string()))?;
-        ctx.configure_mesh()
-            .x_desc(axis_labels.0)
-            .y_desc(axis_labels.1)
-            .label_style(("sans-serif", 12))
-            .x_labels(5)
-            .y_labels(5)
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(|e| err(e.to_string()))?;
-        for layer in &panel.layers {
-            let colour = PALETTE[layer.colour % PALETTE.len()];
-            let style = if layer.faint {
-                colour.mix(0.35).stroke_width(1)
-            } else {
-                colour.stroke_width(2)
-            };
-            ctx.draw_series(
-                layer
-                    .segments
-                    .iter()
-                    .map(|s| PathElement::new(vec![s[0], s[1]], style)),
-            )
-            .map_err(|e| err(e.to_string()))?
-            .label(&layer.name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    let mut rgb = vec![0u8; (size.0 * size.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| err(e.to_string()))?;
+        for (area, panel) in root.split_evenly((rows, columns)).iter().zip(panels) {
+            let mut ctx = ChartBuilder::on(area)
+                .caption(&panel.title, ("sans-serif", 18))
+                .margin(8)
+                .x_label_area_size(35)
+                .y_label_area_size(55)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| err(e.to_string()))?;
+            ctx.configure_mesh()
+                .x_desc(axis_labels.0)
+                .y_desc(axis_labels.1)
+                .label_style(("sans-serif", 12))
+                .x_labels(5)
+                .y_labels(5)
+                .light_line_style(WHITE.mix(0.0))
+                .draw()
+                .map_err(|e| err(e.to_string()))?;
+            for layer in &panel.layers {
+                let colour = PALETTE[layer.colour % PALETTE.len()];
+                let style = if layer.faint {
+                    colour.mix(0.35).stroke_width(1)
+                } else {
+                    colour.stroke_width(2)
+                };
+                ctx.draw_series(
+                    layer
+                        .segments
+                        .iter()
+                        .map(|s| PathElement::new(vec![s[0], s[1]], style)),
+                )
+                .map_err(|e| err(e.to_string()))?
+                .label(&layer.name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            }
+            ctx.configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 12))
+                .position(SeriesLabelPosition::LowerRight)
+                .draw()
+                .map_err(|e| err(e.to_string()))?;
         }
-        ctx.configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 12))
-            .position(SeriesLabelPosition::LowerRight)
-            .draw()
-            .map_err(|e| err(e.to_string()))?;
+        root.present().map_err(|e| err(e.to_string()))?;
     }
-    root.present().map_err(|e| err(e.to_string()))
+    save_rgb(path, &rgb, size)
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Issue 11: outputs are atomic. `incise run` is killed with SIGKILL at pseudo-random
 //! moments, 40 times (10 more runs finish); afterwards every output file is either absent
-//! or complete and parseable (report.json, every .vtu snapshot, run.pvd, the recorded
-//! stroke). Leftover `.tmp` siblings are allowed: they are never read and the next write
+//! or complete and parseable (report.json, every .vtu snapshot, every PNG screenshot,
+//! run.pvd, the recorded stroke). Leftover `.tmp` siblings are allowed: they are never read and the next write
 //! replaces them. Report and stroke are checkpointed every second of simulated time, so a
 //! killed run keeps them up to its last checkpoint.
 
@@ -28,7 +28,7 @@ fn delays(n: usize, full: Duration) -> Vec<Duration> {
 #[test]
 fn a_run_killed_at_any_moment_leaves_only_complete_files() {
     let base = temp_dir("atomic-kill");
-    let (mut vtus, mut reports, mut strokes) = (0, 0, 0);
+    let (mut vtus, mut reports, mut strokes, mut pngs) = (0, 0, 0, 0);
     let args = |out: &std::path::Path, stroke: &std::path::Path| {
         [
             "run",
@@ -39,6 +39,10 @@ fn a_run_killed_at_any_moment_leaves_only_complete_files() {
             "12",
             "--vtu-every",
             "1",
+            "--screenshot-every",
+            "2",
+            "--screenshot-size",
+            "160x120",
             "--quiet",
             "--out",
             out.to_str().unwrap(),
@@ -82,6 +86,12 @@ fn a_run_killed_at_any_moment_leaves_only_complete_files() {
             if name.ends_with(".tmp") {
                 continue;
             }
+            if name.ends_with(".png") {
+                pngs += 1;
+                let ok = incise_xr::RgbaImage::load_png(&path).is_ok();
+                assert!(ok, "kill {k} after {delay:?}: {name} is incomplete");
+                continue;
+            }
             let text = std::fs::read_to_string(&path)
                 .unwrap_or_else(|e| panic!("kill {k} after {delay:?}: {name} unreadable: {e}"));
             let ok = if name.ends_with(".vtu") {
@@ -102,8 +112,9 @@ fn a_run_killed_at_any_moment_leaves_only_complete_files() {
         }
     }
     println!(
-        "checked {vtus} snapshots, {reports} reports, {strokes} strokes after 40 kills and 10 whole runs"
+        "checked {vtus} snapshots, {pngs} screenshots, {reports} reports, {strokes} strokes after 40 kills and 10 whole runs"
     );
+    assert!(pngs > 20, "too few screenshots written to test ({pngs})");
     assert!(
         vtus > 50,
         "the kills came too early to test anything ({vtus} snapshots)"

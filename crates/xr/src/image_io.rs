@@ -1,5 +1,6 @@
 //! RGBA8 images as the renderer reads them back, and their PNG files.
 
+use image::ImageEncoder;
 use std::path::Path;
 
 use crate::error::RenderError;
@@ -44,17 +45,22 @@ impl RgbaImage {
 
     /// Write as PNG (parent folder must exist).
     pub fn save_png(&self, path: &Path) -> Result<(), RenderError> {
-        image::save_buffer(
-            path,
-            &self.pixels,
-            self.width,
-            self.height,
-            image::ExtendedColorType::Rgba8,
-        )
-        .map_err(|e| RenderError::Image {
+        let err = |msg: String| RenderError::Image {
             path: path.into(),
-            msg: e.to_string(),
-        })
+            msg,
+        };
+        let mut png = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut png)
+            .write_image(
+                &self.pixels,
+                self.width,
+                self.height,
+                image::ExtendedColorType::Rgba8,
+            )
+            .map_err(|e| err(e.to_string()))?;
+        // Written to a sibling and renamed: a process killed mid-write leaves the old
+        // file or none, never half a PNG (issue 11).
+        incise_sim::io::write_atomic(path, &png).map_err(|e| err(e.to_string()))
     }
 
     /// Read a PNG (any colour type, converted to RGBA8).
