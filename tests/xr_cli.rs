@@ -49,23 +49,41 @@ fn without_a_runtime_incise_xr_exits_2_saying_what_is_missing() {
     }
 }
 
-fn run_simulated(name: &str, script_text: &str) -> (std::path::PathBuf, Value) {
+/// Write `script_text` as a headset script and run `incise xr ARGS --simulated-headset
+/// SCRIPT --out OUT` on it; the output and the output folder.
+fn run_xr(
+    name: &str,
+    script_text: &str,
+    args: &[&str],
+) -> (std::process::Output, std::path::PathBuf) {
     let dir = temp_dir(name);
     let script = dir.join("headset.ron");
     std::fs::write(&script, script_text).unwrap();
     let out = dir.join("out");
-    let o = incise(&[
-        "xr",
-        "config/plate_cut.ron",
+    let mut all = vec!["xr"];
+    all.extend_from_slice(args);
+    all.extend([
         "--simulated-headset",
         script.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
     ]);
+    (incise(&all), out)
+}
+
+/// The output folder's xr_report.json.
+fn xr_report(out: &Path, o: &std::process::Output) -> Value {
+    serde_json::from_str(
+        &std::fs::read_to_string(out.join("xr_report.json"))
+            .unwrap_or_else(|e| panic!("no xr_report.json ({e}): {}", text(&o.stderr))),
+    )
+    .unwrap()
+}
+
+fn run_simulated(name: &str, script_text: &str) -> (std::path::PathBuf, Value) {
+    let (o, out) = run_xr(name, script_text, &["config/plate_cut.ron"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("xr_report.json")).unwrap())
-            .unwrap();
+    let report = xr_report(&out, &o);
     (out, report)
 }
 
@@ -244,19 +262,7 @@ fn run_with_fault(name: &str, fault: &str) -> (std::process::Output, std::path::
             "render_every: 1000,",
             &format!("render_every: 9, eye_size: (96, 96), faults: [(1.0, {fault})],"),
         );
-    let dir = temp_dir(name);
-    let path = dir.join("headset.ron");
-    std::fs::write(&path, script).unwrap();
-    let out = dir.join("out");
-    let o = incise(&[
-        "xr",
-        "config/plate_cut.ron",
-        "--simulated-headset",
-        path.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    (o, out)
+    run_xr(name, &script, &["config/plate_cut.ron"])
 }
 
 /// Issue 11: a runtime that loses the session (LOSS_PENDING, or calls failing with
@@ -275,11 +281,7 @@ fn a_lost_or_ending_runtime_stops_the_session_cleanly_and_keeps_its_outputs() {
     ] {
         let (o, out) = run_with_fault(&format!("xr-fault-{fault}"), fault);
         let err = text(&o.stderr);
-        let report: Value = serde_json::from_str(
-            &std::fs::read_to_string(out.join("xr_report.json"))
-                .unwrap_or_else(|e| panic!("{fault}: no xr_report.json ({e}): {err}")),
-        )
-        .unwrap();
+        let report = xr_report(&out, &o);
         let said = report["exit"].as_str().unwrap();
         assert!(said.starts_with(exit), "{fault}: exit {said}: {err}");
         if fault == "RuntimeFailure" {
@@ -332,26 +334,23 @@ fn run_exercise_session(
     name: &str,
     script: &str,
 ) -> (std::path::PathBuf, Value, std::process::Output) {
-    let dir = temp_dir(name);
-    let path = dir.join("headset.ron");
-    std::fs::write(&path, script).unwrap();
-    let out = dir.join("out");
-    let o = incise(&[
-        "xr",
-        "--exercise",
-        "config/exercises/slab_depth.ron",
-        "--simulated-headset",
-        path.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--history",
-        dir.join("history.jsonl").to_str().unwrap(),
-    ]);
-    let report = serde_json::from_str(
-        &std::fs::read_to_string(out.join("xr_report.json"))
-            .unwrap_or_else(|e| panic!("no xr_report.json ({e}): {}", text(&o.stderr))),
-    )
-    .unwrap();
+    // The history goes into the output folder (created by incise).
+    let out_dir = std::env::temp_dir()
+        .join(format!("incise-e2e-{}-{name}", std::process::id()))
+        .join("out");
+    let history = out_dir.join("history.jsonl");
+    let (o, out) = run_xr(
+        name,
+        script,
+        &[
+            "--exercise",
+            "config/exercises/slab_depth.ron",
+            "--history",
+            history.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(out, out_dir);
+    let report = xr_report(&out, &o);
     (out, report, o)
 }
 
@@ -391,7 +390,7 @@ fn an_exercise_in_the_headset_is_scored_on_a_and_shows_its_card() {
     for f in ["result.json", "report.html", "stroke.ron", "card.png"] {
         assert!(dir.join(f).exists(), "{f} missing in {}", dir.display());
     }
-    let history = std::fs::read_to_string(out.parent().unwrap().join("history.jsonl")).unwrap();
+    let history = std::fs::read_to_string(out.join("history.jsonl")).unwrap();
     assert_eq!(history.lines().count(), 1);
 
     // The plan is drawn while cutting (violet ink, sRGB #6A1B9A-ish) and the card only

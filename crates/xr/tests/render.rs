@@ -7,6 +7,10 @@
 //! then they fail. `INCISE_UPDATE_GOLDEN=1` rewrites the stored images instead of
 //! comparing (inspect them before committing).
 
+mod common;
+
+use common::device;
+
 use std::path::PathBuf;
 
 use glam::{UVec3, Vec2, Vec3};
@@ -19,26 +23,12 @@ use incise_sim::{Material, Solver, SolverParams, TetMesh};
 use incise_xr::compare::{Tolerance, compare};
 use incise_xr::frame::{MATERIAL_IDS, pinned_nodes};
 use incise_xr::{
-    BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage,
-    ShadingMode, View,
+    BodyState, Camera, OffscreenRenderer, Overlays, RenderSettings, RgbaImage, ShadingMode, View,
 };
 
 const SIZE: (u32, u32) = (320, 240);
 /// The bar's cut threshold, Pa.
 const BAR_THRESHOLD: f32 = 6e3;
-
-fn device() -> Option<RenderDevice> {
-    match RenderDevice::headless() {
-        Ok(d) => Some(d),
-        Err(e) if std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-            panic!("INCISE_REQUIRE_GPU=1 but {e}")
-        }
-        Err(e) => {
-            eprintln!("skipping render test: {e}");
-            None
-        }
-    }
-}
 
 /// Compare with `tests/golden/NAME.png`; on failure write the image and a diff beside the
 /// test binaries and fail naming them.

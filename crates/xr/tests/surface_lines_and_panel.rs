@@ -6,6 +6,10 @@
 //! Without an adapter the tests print why and pass, unless `INCISE_REQUIRE_GPU=1` (CI):
 //! then they fail.
 
+mod common;
+
+use common::device;
+
 use glam::{Mat4, Quat, UVec3, Vec2, Vec3};
 use incise_sim::TetMesh;
 use incise_sim::cutting::CutState;
@@ -13,26 +17,13 @@ use incise_sim::generate::block;
 use incise_sim::skin::Skin;
 use incise_xr::frame::MATERIAL_IDS;
 use incise_xr::{
-    BodyState, Camera, OffscreenRenderer, RenderDevice, RenderError, RenderSettings, RgbaImage,
-    ShadingMode, SurfaceLine, View,
+    BodyState, Camera, OffscreenRenderer, RenderError, RenderSettings, RgbaImage, ShadingMode,
+    SurfaceLine, View,
 };
 
 const SIZE: (u32, u32) = (320, 240);
 /// Width of the drawn line, m (about 9 pixels in the views below).
 const WIDTH: f32 = 0.004;
-
-fn device() -> Option<RenderDevice> {
-    match RenderDevice::headless() {
-        Ok(d) => Some(d),
-        Err(e) if std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-            panic!("INCISE_REQUIRE_GPU=1 but {e}")
-        }
-        Err(e) => {
-            eprintln!("skipping render test: {e}");
-            None
-        }
-    }
-}
 
 fn full() -> Vec2 {
     Vec2::new(SIZE.0 as f32, SIZE.1 as f32)
