@@ -181,11 +181,12 @@ fn main() -> ExitCode {
         .and_then(|r| {
             let last = r.cycles.last();
             println!(
-                "{} cuts in {:.0} s on {}: memory {:+.1} %, descriptors {:+}, p99 frame {:.1} ms (last cut), every cut {} the first",
+                "{} cuts in {:.0} s on {}: memory {:+.1} % (peak {:+.1} %), descriptors {:+}, p99 frame {:.1} ms (last cut), every cut {} the first",
                 r.cycles.len(),
                 r.seconds,
                 r.device,
                 r.rss_growth * 100.0,
+                r.rss_peak_growth * 100.0,
                 r.fd_growth,
                 last.map_or(0.0, |c| c.p99_ms),
                 if r.problems.iter().any(|p| p.contains("other tets")) { "differs from" } else { "matches" },
