@@ -166,7 +166,8 @@ impl Panel {
                     ui.separator();
                     self.settings_section(ui, &mut actions);
                     ui.separator();
-                    self.scalpel_section(ui, &info.scalpel, &mut actions);
+                    let attempt = info.exercise.as_ref().is_some_and(|e| e.running.is_some());
+                    self.scalpel_section(ui, &info.scalpel, attempt, &mut actions);
                     ui.separator();
                     self.overlay_section(ui, info);
                     ui.separator();
@@ -363,7 +364,14 @@ impl Panel {
         }
     }
 
-    fn scalpel_section(&mut self, ui: &mut egui::Ui, s: &ScalpelInfo, actions: &mut Vec<Action>) {
+    /// `attempt`: an exercise attempt is under way (it owns the recording).
+    fn scalpel_section(
+        &mut self,
+        ui: &mut egui::Ui,
+        s: &ScalpelInfo,
+        attempt: bool,
+        actions: &mut Vec<Action>,
+    ) {
         ui.heading("Scalpel");
         let state = match (s.stroke.1, s.cutting, s.parked) {
             (true, ..) => "the scene's stroke moves it",
@@ -394,6 +402,10 @@ impl Panel {
             ui.text_edit_singleline(&mut self.stroke_file);
         });
         match s.recording {
+            // The attempt records the stroke and saves it when finished.
+            Some(n) if attempt => {
+                ui.label(format!("recording the attempt: {n} poses"));
+            }
             None => {
                 if ui.button("Record stroke").clicked() {
                     actions.push(Action::StartRecording);
