@@ -70,6 +70,19 @@ impl Body {
         }
     }
 
+    /// Testing aid: a NaN velocity on the first free node (none: nothing happens); the
+    /// next frame must fail and be rolled back.
+    pub fn inject_nan(&mut self) {
+        let node = self
+            .solver()
+            .node_kinds()
+            .iter()
+            .position(|k| *k == incise_sim::xpbd::NodeKind::Free);
+        if let Some(node) = node {
+            self.inject_non_finite(node);
+        }
+    }
+
     /// Advance one frame.
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
         match self {

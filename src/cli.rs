@@ -120,6 +120,10 @@ pub enum Command {
         /// Results history exercise attempts are appended to.
         #[arg(long, default_value = "results/history.jsonl")]
         history: PathBuf,
+        /// Testing aid: give a node a NaN velocity just before simulation frame N (the
+        /// frame is rolled back, an exercise attempt saved, the scene reset).
+        #[arg(long, value_name = "N")]
+        inject_nan_at: Option<u64>,
     },
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {

@@ -123,6 +123,7 @@ fn main() -> ExitCode {
             device,
             exercise,
             history,
+            inject_nan_at,
         } => incise::xr::run(&incise::xr::XrOptions {
             scene: scene.unwrap_or_else(|| XR_SCENE.into()),
             simulated: simulated_headset,
@@ -132,6 +133,7 @@ fn main() -> ExitCode {
             device,
             exercise,
             history,
+            inject_nan_at,
         })
         .map(|r| println!("{}", r.summary())),
         Command::Render {

@@ -233,13 +233,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
             body.inject_device_loss();
         }
         if opts.inject_nan_at == Some(f) {
-            let kinds = body.solver().node_kinds();
-            if let Some(node) = kinds
-                .iter()
-                .position(|k| *k == incise_sim::xpbd::NodeKind::Free)
-            {
-                body.inject_non_finite(node);
-            }
+            body.inject_nan();
         }
         let mut stepped = body.step_frame();
         if let Err(SolverError::Device(msg)) = &stepped {

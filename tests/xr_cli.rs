@@ -333,22 +333,21 @@ fn exercise_script(duration: f64, extra: &str) -> String {
 fn run_exercise_session(
     name: &str,
     script: &str,
+    extra: &[&str],
 ) -> (std::path::PathBuf, Value, std::process::Output) {
     // The history goes into the output folder (created by incise).
     let out_dir = std::env::temp_dir()
         .join(format!("incise-e2e-{}-{name}", std::process::id()))
         .join("out");
     let history = out_dir.join("history.jsonl");
-    let (o, out) = run_xr(
-        name,
-        script,
-        &[
-            "--exercise",
-            "config/exercises/slab_depth.ron",
-            "--history",
-            history.to_str().unwrap(),
-        ],
-    );
+    let mut args = vec![
+        "--exercise",
+        "config/exercises/slab_depth.ron",
+        "--history",
+        history.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let (o, out) = run_xr(name, script, &args);
     assert_eq!(out, out_dir);
     let report = xr_report(&out, &o);
     (out, report, o)
@@ -377,6 +376,7 @@ fn an_exercise_in_the_headset_is_scored_on_a_and_shows_its_card() {
     let (out, r, o) = run_exercise_session(
         "xr-exercise",
         &exercise_script(2.2, "buttons: [(1.8, A)], screenshots: [36, 144]"),
+        &[],
     );
     let err = text(&o.stderr);
     assert!(o.status.success(), "{err}");
@@ -462,6 +462,7 @@ fn an_attempt_under_way_is_saved_when_the_session_is_lost() {
     let (_, r, o) = run_exercise_session(
         "xr-exercise-lost",
         &exercise_script(3.0, "faults: [(1.6, SessionLoss)]"),
+        &[],
     );
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert_eq!(r["exit"], "SessionLost", "{r}");
@@ -470,4 +471,31 @@ fn an_attempt_under_way_is_saved_when_the_session_is_lost() {
     assert_eq!(attempts[0]["ended_by"], "session ended");
     let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
     assert!(dir.join("result.json").exists());
+}
+
+/// A solver failure mid-attempt (a NaN injected at simulation frame 45, 0.75 s: the blade
+/// is in the tissue) rolls the frame back; the attempt is scored and saved as it stood,
+/// the scene reset, and the rest of the stroke is a second attempt saved at the end.
+#[test]
+fn a_solver_failure_saves_the_attempt_before_the_scene_is_reset() {
+    let (_, r, o) = run_exercise_session(
+        "xr-exercise-nan",
+        &exercise_script(2.0, ""),
+        &["--inject-nan-at", "45"],
+    );
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(r["solver_resets"].as_u64(), Some(1), "{r}");
+    let attempts = r["attempts"].as_array().unwrap();
+    assert_eq!(attempts.len(), 2, "{r}");
+    let first = attempts[0]["ended_by"].as_str().unwrap();
+    assert!(
+        first.starts_with("solver failed") && first.contains("frame"),
+        "{first}"
+    );
+    assert_eq!(attempts[1]["ended_by"], "session ended");
+    for a in attempts {
+        let dir = std::path::PathBuf::from(a["dir"].as_str().unwrap());
+        assert!(dir.join("result.json").exists() && dir.join("stroke.ron").exists());
+    }
 }

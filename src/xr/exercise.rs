@@ -168,9 +168,16 @@ impl XrExercise {
         Ok(())
     }
 
-    /// The solver failed and the scene is being reset: the attempt is lost.
-    pub fn abort(&mut self) {
-        self.live.abort(&mut self.stroke);
+    /// The solver failed (`why`; its last frame rolled back) and the scene is about to
+    /// be reset: an attempt the blade touched is scored and saved as it stood, others are
+    /// dropped.
+    pub fn on_solver_failure(&mut self, xr: &XrBody, why: &str) -> Result<()> {
+        if self.live.touched() {
+            self.finish(xr, &format!("solver failed: {why}"))
+        } else {
+            self.live.abort(&mut self.stroke);
+            Ok(())
+        }
     }
 
     fn finish(&mut self, xr: &XrBody, why: &str) -> Result<()> {

@@ -47,6 +47,9 @@ pub struct LoopOptions<'a> {
     pub record: bool,
     /// The tray at the start.
     pub tray: Tray,
+    /// Testing aid: a NaN in the solver just before this simulation frame of the session
+    /// (the frame fails, is rolled back and the scene reset).
+    pub inject_nan_at: Option<u64>,
 }
 
 /// What a session did.
@@ -132,6 +135,7 @@ pub fn run_loop(
     let (background, background_alpha) = headset.backdrop().clear();
     let mut idle = 0;
     let mut exit_asked = false;
+    let mut inject_nan_at = opts.inject_nan_at;
     // Every frame runs inside this closure so that a failure mid-frame still ends with
     // the stroke, the frame log and the report saved.
     let mut session = || -> Result<()> {
@@ -191,8 +195,13 @@ pub fn run_loop(
             }
             let sim_start = Instant::now();
             let mut force = 0.0f32;
+            let mut stepped = 0u64;
             for _ in 0..plan.sim_frames {
                 xr.drive_tool(tool_pose, engaged)?;
+                if inject_nan_at == Some(out.sim_frames + stepped) {
+                    inject_nan_at = None;
+                    xr.body.inject_nan();
+                }
                 let stats = match xr.step() {
                     Ok(s) => s,
                     Err(e) => {
@@ -200,15 +209,20 @@ pub fn run_loop(
                         // back; start the scene again rather than end the trainee's session.
                         eprintln!("xr: {e:#}; resetting the scene");
                         out.solver_resets += 1;
+                        // The frame was rolled back: an attempt the blade touched is
+                        // scored and saved as it stood, then a new one starts.
+                        if let Some(ex) = exercise.as_deref_mut() {
+                            ex.on_solver_failure(xr, &format!("{e:#}"))?;
+                        }
                         xr.reset()?;
                         if let Some(ex) = exercise.as_deref_mut() {
-                            ex.abort();
                             ex.start(xr, skin, &dev)?;
                         }
                         break;
                     }
                 };
                 sim_time += sim_dt;
+                stepped += 1;
                 if let Some(ex) = exercise.as_deref_mut() {
                     ex.after_step(&stats, tool_pose, sim_dt)?;
                 }
@@ -222,7 +236,7 @@ pub fn run_loop(
                 pacer.record(plan, sim_ms * 1e-3);
                 out.min_substeps_used = out.min_substeps_used.min(plan.substeps);
             }
-            out.sim_frames += plan.sim_frames as u64;
+            out.sim_frames += stepped;
             out.max_tool_force = out.max_tool_force.max(force);
 
             let amplitude = (opts.haptic)(force);

@@ -49,6 +49,8 @@ pub struct XrOptions {
     pub exercise: Option<PathBuf>,
     /// Results history exercise attempts are appended to.
     pub history: PathBuf,
+    /// Testing aid: a NaN in the solver just before this simulation frame.
+    pub inject_nan_at: Option<u64>,
 }
 
 /// The session summary written as `xr_report.json`.
@@ -191,6 +193,7 @@ fn run_session(
             nominal_pacing,
             record: true,
             tray,
+            inject_nan_at: opts.inject_nan_at,
         },
         exercise.as_deref_mut(),
     )?;
@@ -206,7 +209,7 @@ fn run_session(
     }
     let quant = |q| outcome.log.frame_ms_quantile(q);
     let report = XrReport {
-        scene: opts.scene.display().to_string(),
+        scene: xr.scene_path().display().to_string(),
         headset: describe,
         solver_device: xr.body.device(),
         frames: outcome.frames,

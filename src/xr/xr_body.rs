@@ -145,6 +145,11 @@ impl XrBody {
         }
     }
 
+    /// The scene file.
+    pub fn scene_path(&self) -> &Path {
+        &self.path
+    }
+
     /// The scalpel's last pose, and whether the controller is tracked.
     pub fn tool(&self) -> (ToolPose, bool) {
         (self.pose, self.tracked)
