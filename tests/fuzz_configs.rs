@@ -1,5 +1,5 @@
-//! Issue 11: the RON parsers of scenes, tools and strokes survive mutation fuzzing seeded
-//! with the shipped files (≥ 100k inputs per format by default, `INCISE_FUZZ_INPUTS` to
+//! Issue 11: the RON parsers of scenes, tools, strokes, exercises and headset scripts
+//! survive mutation fuzzing seeded with the shipped files (≥ 100k inputs per format by default, `INCISE_FUZZ_INPUTS` to
 //! change): no panic, no input slower than 1 s, never more than 10× the input allocated.
 
 #[path = "../crates/sim/tests/fuzz/mutator.rs"]
@@ -38,10 +38,10 @@ fn stroke_seed() -> Vec<u8> {
 type Parser = fn(&str, &Path) -> bool;
 
 #[test]
-fn mutated_scenes_tools_and_strokes_never_panic_hang_or_overallocate() {
+fn mutated_configs_never_panic_hang_or_overallocate() {
     let count = inputs_per_format();
     let path = Path::new("fuzz.ron");
-    let formats: [(&str, Vec<Vec<u8>>, Parser); 3] = [
+    let formats: [(&str, Vec<Vec<u8>>, Parser); 5] = [
         ("scene", files("config"), |t, p| {
             incise::scene::parse_scene(t, p).is_ok()
         }),
@@ -50,6 +50,12 @@ fn mutated_scenes_tools_and_strokes_never_panic_hang_or_overallocate() {
         }),
         ("stroke", vec![stroke_seed()], |t, p| {
             incise_scalpel::parse_stroke(t, p).is_ok()
+        }),
+        ("exercise", files("config/exercises"), |t, p| {
+            incise::exercise::parse_exercise(t, p).is_ok()
+        }),
+        ("headset script", files("config/xr"), |t, p| {
+            incise::xr::script::HeadsetScript::parse(t, p).is_ok()
         }),
     ];
     for (k, (name, seeds, parse)) in formats.into_iter().enumerate() {

@@ -186,7 +186,12 @@ impl HeadsetScript {
     pub fn load(path: &Path) -> Result<Self> {
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        let s: HeadsetScript = ron::from_str(&text).map_err(|e| {
+        Self::parse(&text, path)
+    }
+
+    /// Parse and check a script's text (`path` names it in errors).
+    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        let s: HeadsetScript = ron::from_str(text).map_err(|e| {
             anyhow::anyhow!(
                 "{}:{}:{}: {}",
                 path.display(),
