@@ -374,7 +374,7 @@ impl Panel {
     ) {
         ui.heading("Scalpel");
         let state = match (s.stroke.1, s.cutting, s.parked) {
-            (true, ..) => "the scene's stroke moves it",
+            (true, ..) => "a stroke moves it (the scene's, or the exercise's reference)",
             (_, true, _) => "cutting",
             (_, _, true) => "parked: move the cursor over the tissue",
             _ => "lifted",
