@@ -166,77 +166,27 @@ impl WindowGpu {
         for id in &panel.textures.free {
             self.egui.free_texture(id);
         }
-        let staging =
-            (capture && self.can_capture).then(|| self.copy_out(&mut enc, &frame.texture));
         queue.submit(extra.into_iter().chain([enc.finish()]));
-        let image = match staging {
-            Some((buffer, row)) => Some(self.read(&buffer, row)?),
-            None => None,
+        // The surface texture stays valid until it is presented: read it back like any
+        // offscreen target, then put the surface's channel order into RGBA.
+        let image = if capture && self.can_capture {
+            let mut img = incise_xr::offscreen::read_texture(device, queue, &frame.texture)
+                .map_err(|e| anyhow!("window capture: {e}"))?;
+            let bgra = matches!(
+                self.config.format,
+                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+            );
+            for p in img.pixels.chunks_exact_mut(4) {
+                if bgra {
+                    p.swap(0, 2);
+                }
+                p[3] = 255;
+            }
+            Some(img)
+        } else {
+            None
         };
         queue.present(frame);
         Ok(Some(image))
-    }
-
-    fn copy_out(
-        &self,
-        enc: &mut wgpu::CommandEncoder,
-        texture: &wgpu::Texture,
-    ) -> (wgpu::Buffer, u32) {
-        let (w, h) = self.size();
-        let row = (w * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-        let buffer = self.dev.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("window capture"),
-            size: row as u64 * h as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        enc.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
-        (buffer, row)
-    }
-
-    fn read(&self, buffer: &wgpu::Buffer, row: u32) -> Result<RgbaImage> {
-        let (w, h) = self.size();
-        buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        self.dev
-            .device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| anyhow!("window capture: {e}"))?;
-        let data = buffer
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| anyhow!("window capture: {e}"))?;
-        let bgra = matches!(
-            self.config.format,
-            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
-        );
-        let mut pixels = Vec::with_capacity((w * h * 4) as usize);
-        for y in 0..h as usize {
-            for p in data[y * row as usize..][..w as usize * 4].chunks_exact(4) {
-                let (r, b) = if bgra { (p[2], p[0]) } else { (p[0], p[2]) };
-                pixels.extend_from_slice(&[r, p[1], b, 255]);
-            }
-        }
-        drop(data);
-        buffer.unmap();
-        Ok(RgbaImage {
-            width: w,
-            height: h,
-            pixels,
-        })
     }
 }
