@@ -20,7 +20,7 @@ use serde::Serialize;
 
 use super::xr_body::XrBody;
 use crate::body::Body;
-use crate::exercise::{DECAL_COLOUR, DECAL_WIDTH, LiveExercise, LoadedExercise, StrokeSource};
+use crate::exercise::{LiveExercise, LoadedExercise, StrokeSource};
 use crate::screenshots::{ImageSize, Screenshots};
 
 /// Size of the report's before/after pictures, pixels.
@@ -76,8 +76,6 @@ impl StrokeSource for ControllerStroke {
 pub struct XrExercise {
     live: LiveExercise,
     stroke: ControllerStroke,
-    /// Simulated frames of the attempt under way (the stroke's clock).
-    frames: u64,
     out_root: PathBuf,
     history: PathBuf,
     /// The card on show.
@@ -95,7 +93,6 @@ impl XrExercise {
         Ok(XrExercise {
             live: LiveExercise::open(path)?,
             stroke: ControllerStroke::default(),
-            frames: 0,
             out_root: out_root.to_path_buf(),
             history: history.to_path_buf(),
             card: None,
@@ -113,7 +110,6 @@ impl XrExercise {
     /// are rendered on `dev`.
     pub fn start(&mut self, xr: &mut XrBody, skin: &Skin, dev: &RenderDevice) -> Result<()> {
         self.card_changed |= self.card.take().is_some();
-        self.frames = 0;
         let pictures = Screenshots::new(Some(dev), xr.solver(), skin, PICTURE, Default::default())
             .map(|s| {
                 let s = s
@@ -136,13 +132,11 @@ impl XrExercise {
         pose: Option<ToolPose>,
         dt: f64,
     ) -> Result<()> {
-        if self.live.running().is_none() {
-            return Ok(());
-        }
-        self.frames += 1;
         self.live.after_step(stats);
+        // The attempt's clock: its frames so far (none kept without an attempt).
+        let frames = self.live.running().unwrap_or(0);
         if let (Some(r), Some(p)) = (&mut self.stroke.recorder, pose) {
-            r.push(self.frames as f64 * dt, p)?;
+            r.push(frames as f64 * dt, p)?;
         }
         Ok(())
     }
@@ -210,13 +204,7 @@ impl XrExercise {
     /// The plan on the tissue as it is now (where not cut away).
     pub fn lines(&self, xr: &XrBody) -> Vec<SurfaceLine> {
         let s = xr.solver();
-        let d = self.live.decal.line_uncut(s.positions(), s.cut().live());
-        vec![SurfaceLine {
-            points: d.points,
-            normals: d.normals,
-            width: DECAL_WIDTH,
-            colour: DECAL_COLOUR,
-        }]
+        vec![self.live.decal.line_uncut(s.positions(), s.cut().live())]
     }
 
     /// The card's placement (sim world) for a head at `head` (stage), uploading the card

@@ -170,10 +170,7 @@ pub fn run_loop(
                     None => true,
                 };
                 if reset {
-                    xr.reset()?;
-                    if let Some(ex) = exercise.as_deref_mut() {
-                        ex.start(xr, skin, &dev)?;
-                    }
+                    restart(xr, exercise.as_deref_mut(), skin, &dev)?;
                 }
             }
             stress ^= cmd.toggle_stress;
@@ -214,10 +211,7 @@ pub fn run_loop(
                         if let Some(ex) = exercise.as_deref_mut() {
                             ex.on_solver_failure(xr, &format!("{e:#}"))?;
                         }
-                        xr.reset()?;
-                        if let Some(ex) = exercise.as_deref_mut() {
-                            ex.start(xr, skin, &dev)?;
-                        }
+                        restart(xr, exercise.as_deref_mut(), skin, &dev)?;
                         break;
                     }
                 };
@@ -360,4 +354,18 @@ pub fn run_loop(
         out.stroke = Some(recorder.finish()?);
     }
     Ok(out)
+}
+
+/// The scene back to rest, and a new exercise attempt on it.
+fn restart(
+    xr: &mut XrBody,
+    exercise: Option<&mut XrExercise>,
+    skin: &Skin,
+    dev: &incise_xr::RenderDevice,
+) -> Result<()> {
+    xr.reset()?;
+    if let Some(ex) = exercise {
+        ex.start(xr, skin, dev)?;
+    }
+    Ok(())
 }
