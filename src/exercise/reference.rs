@@ -43,9 +43,9 @@ struct TiltedEdge {
     low: f64,
     /// x of the lowest edge point, m.
     x_low: f64,
-    /// x range of the edge within `depth` of its lowest point (the part in the tissue
-    /// when the lowest point is at the target depth), m.
-    in_tissue: (f64, f64),
+    /// Rearmost x of the edge within `depth` of its lowest point (where the part in the
+    /// tissue starts when the lowest point is at the target depth), m.
+    entry: f64,
 }
 
 impl TiltedEdge {
@@ -74,19 +74,17 @@ impl TiltedEdge {
             .iter()
             .copied()
             .fold((0.0, f64::INFINITY), |m, p| if p.1 < m.1 { p } else { m });
-        let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
-        for &(x, z) in &dense {
-            if z - low < depth {
-                (a, b) = (a.min(x), b.max(x));
-            }
-        }
-        TiltedEdge {
-            low,
-            x_low,
-            in_tissue: (a, b),
-        }
+        let entry = dense
+            .iter()
+            .filter(|p| p.1 - low < depth)
+            .map(|p| p.0)
+            .fold(f64::INFINITY, f64::min);
+        TiltedEdge { low, x_low, entry }
     }
 }
+
+/// How far ahead along the plan the blade's heading is taken, m.
+const HEADING_LOOKAHEAD: f64 = 0.005;
 
 /// Tilt at which the reference stroke finishes, on the tip (degrees).
 const FINISH_TILT_DEG: f64 = 75.0;
@@ -133,7 +131,7 @@ pub fn reference_stroke(ex: &LoadedExercise, style: ReferenceStyle) -> Result<St
         let e = at(tilt);
         let s = q - e.x_low;
         let (tip, n) = point_at(s);
-        let ahead = point_at(s + KEY_SPACING.max(0.005)).0 - point_at(s).0;
+        let ahead = point_at(s + HEADING_LOOKAHEAD).0 - tip;
         let mut h = (ahead - n * ahead.dot(n)).normalize_or_zero();
         if h == DVec3::ZERO {
             h = n.any_orthonormal_vector();
@@ -145,7 +143,7 @@ pub fn reference_stroke(ex: &LoadedExercise, style: ReferenceStyle) -> Result<St
         ((tip + n * (-e.low - depth)).as_vec3(), rotation.normalize())
     };
     let start = at(tilt0);
-    let q0 = start.x_low - start.in_tissue.0;
+    let q0 = start.x_low - start.entry;
     // The lowest point stops short of the end by half the lateral tolerance: the cutting
     // spheres and the tets they release reach that far beyond the edge itself.
     let end = plan.length - 0.5 * ex.exercise.tolerance.lateral as f64;
