@@ -7,10 +7,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use incise_sim::TetMesh;
-use incise_sim::cutting::CutState;
 use incise_sim::generate::{IntestineParams, intestine};
 use incise_sim::skin::Skin;
-use incise_xr::{BodyState, Camera, OffscreenRenderer, RenderDevice, RenderSettings, View};
+use incise_xr::{Camera, OffscreenRenderer, RenderDevice, RenderSettings, UncutBody, View};
 use serde::Serialize;
 
 /// Smallest skin the benchmark draws, triangles (issue 6).
@@ -77,15 +76,8 @@ fn median(v: &mut [f64]) -> f64 {
 pub fn run(frames: u32, json: bool) -> Result<()> {
     let dev = RenderDevice::headless()?;
     let (mesh, skin) = fine_intestine(MIN_SKIN_TRIANGLES);
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
-    let state = BodyState {
-        positions: &mesh.rest_positions,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let body = UncutBody::new(&mesh);
+    let state = body.state(&mesh.rest_positions);
     let settings = RenderSettings::default();
     let (lo, hi) = mesh.rest_bounds();
     let mut results = Vec::new();

@@ -1,9 +1,9 @@
 //! What the renderer is given each frame: the body's state and the display settings.
 
 use glam::{Mat4, Vec3};
-use incise_sim::Solver;
 use incise_sim::cutting::CutState;
 use incise_sim::xpbd::NodeKind;
+use incise_sim::{Solver, TetMesh};
 
 /// The simulated body as of the last frame.
 #[derive(Clone, Copy)]
@@ -31,6 +31,34 @@ impl<'a> BodyState<'a> {
             cut: solver.cut(),
             von_mises: solver.von_mises(),
             pinned,
+        }
+    }
+}
+
+/// An uncut, unstressed body of a mesh, nothing pinned: with any node positions it makes
+/// a [`BodyState`] (benchmarks, tests, pictures of a mesh as it is).
+pub struct UncutBody {
+    cut: CutState,
+    von_mises: Vec<f32>,
+}
+
+impl UncutBody {
+    /// Every tet of `mesh` live, zero stress.
+    pub fn new(mesh: &TetMesh) -> Self {
+        UncutBody {
+            cut: CutState::new(mesh),
+            von_mises: vec![0.0; mesh.tet_count()],
+        }
+    }
+
+    /// The body with its nodes at `positions` (host), m.
+    pub fn state<'a>(&'a self, positions: &'a [Vec3]) -> BodyState<'a> {
+        BodyState {
+            positions,
+            device_positions: None,
+            cut: &self.cut,
+            von_mises: &self.von_mises,
+            pinned: &[],
         }
     }
 }

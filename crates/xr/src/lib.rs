@@ -31,7 +31,9 @@ pub mod tool_mesh;
 pub use camera::{Camera, View};
 pub use device::RenderDevice;
 pub use error::RenderError;
-pub use frame::{BodyState, Overlays, RenderSettings, ShadingMode, SurfaceLine, ToolState};
+pub use frame::{
+    BodyState, Overlays, RenderSettings, ShadingMode, SurfaceLine, ToolState, UncutBody,
+};
 pub use image_io::RgbaImage;
 pub use offscreen::OffscreenRenderer;
 pub use renderer::Renderer;

@@ -14,7 +14,6 @@ use common::device;
 use std::path::PathBuf;
 
 use glam::{UVec3, Vec2, Vec3};
-use incise_sim::cutting::CutState;
 use incise_sim::generate::{IntestineParams, block, intestine};
 use incise_sim::grab::Grab;
 use incise_sim::selection::NodeSelection;
@@ -23,7 +22,8 @@ use incise_sim::{Material, Solver, SolverParams, TetMesh};
 use incise_xr::compare::{Tolerance, compare};
 use incise_xr::frame::{MATERIAL_IDS, pinned_nodes};
 use incise_xr::{
-    BodyState, Camera, OffscreenRenderer, Overlays, RenderSettings, RgbaImage, ShadingMode, View,
+    BodyState, Camera, OffscreenRenderer, Overlays, RenderSettings, RgbaImage, ShadingMode,
+    UncutBody, View,
 };
 
 const SIZE: (u32, u32) = (320, 240);
@@ -148,15 +148,8 @@ fn step(s: &mut Solver, frames: usize) {
 fn golden_rest_intestine() {
     let Some(dev) = device() else { return };
     let (mesh, skin) = rest_intestine();
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
-    let state = BodyState {
-        positions: &mesh.rest_positions,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let body = UncutBody::new(&mesh);
+    let state = body.state(&mesh.rest_positions);
     let (lo, hi) = mesh.rest_bounds();
     let mut cam = Camera::framing(lo, hi, -1.1, 0.6);
     cam.zoom(0.72);
@@ -276,15 +269,8 @@ fn gpu_skin_equals_its_barycentric_combination_after_a_large_deformation() {
             )
         })
         .collect();
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
-    let state = BodyState {
-        positions: &deformed,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let body = UncutBody::new(&mesh);
+    let state = body.state(&deformed);
     let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, (64, 48), 1).unwrap();
     let view = Camera::framing(Vec3::splat(-0.2), Vec3::splat(0.2), 0.0, 0.3).view(4.0 / 3.0);
     r.render(&state, &RenderSettings::default(), &[view]);
@@ -319,15 +305,8 @@ fn both_eyes_of_a_stereo_target_are_drawn() {
         .unwrap()
         .0;
     let skin = Skin::from_boundary(&mesh);
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
-    let state = BodyState {
-        positions: &mesh.rest_positions,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let body = UncutBody::new(&mesh);
+    let state = body.state(&mesh.rest_positions);
     let (lo, hi) = mesh.rest_bounds();
     let centre = Camera::framing(lo, hi, -1.0, 0.5).view(4.0 / 3.0);
     let right = centre.view.inverse().x_axis.truncate();

@@ -12,13 +12,12 @@ use common::device;
 
 use glam::{Mat4, Quat, UVec3, Vec2, Vec3};
 use incise_sim::TetMesh;
-use incise_sim::cutting::CutState;
 use incise_sim::generate::block;
 use incise_sim::skin::Skin;
 use incise_xr::frame::MATERIAL_IDS;
 use incise_xr::{
-    BodyState, Camera, OffscreenRenderer, RenderError, RenderSettings, RgbaImage, ShadingMode,
-    SurfaceLine, View,
+    Camera, OffscreenRenderer, RenderError, RenderSettings, RgbaImage, ShadingMode, SurfaceLine,
+    UncutBody, View,
 };
 
 const SIZE: (u32, u32) = (320, 240);
@@ -110,15 +109,8 @@ fn assert_plan_along(img: &RgbaImage, view: &View, line: &SurfaceLine, what: &st
 fn a_line_on_the_plate_is_drawn_with_its_width_and_hidden_from_below() {
     let Some(dev) = device() else { return };
     let (mesh, skin) = plate();
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
-    let state = BodyState {
-        positions: &mesh.rest_positions,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let body = UncutBody::new(&mesh);
+    let state = body.state(&mesh.rest_positions);
     let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 1).unwrap();
     let line = line_across(0.01, Vec3::ZERO);
     let settings = ids(vec![line.clone()], None);
@@ -173,19 +165,12 @@ fn a_line_on_the_plate_is_drawn_with_its_width_and_hidden_from_below() {
 fn the_line_follows_the_deformed_tissue() {
     let Some(dev) = device() else { return };
     let (mesh, skin) = plate();
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
+    let body = UncutBody::new(&mesh);
     // The tissue moves 12 mm along +y and rises 4 mm; the app's embedded plan points
     // move with it.
     let shift = Vec3::new(0.0, 0.012, 0.004);
     let moved: Vec<Vec3> = mesh.rest_positions.iter().map(|p| *p + shift).collect();
-    let state = BodyState {
-        positions: &moved,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let state = body.state(&moved);
     let (rest_line, moved_line) = (line_across(0.0, Vec3::ZERO), line_across(0.0, shift));
     let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 1).unwrap();
     let view = vertical_view(true);
@@ -233,15 +218,8 @@ fn quadrants() -> Vec<u8> {
 fn the_panel_shows_its_image_the_right_way_round_over_the_scene() {
     let Some(dev) = device() else { return };
     let (mesh, skin) = plate();
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
-    let state = BodyState {
-        positions: &mesh.rest_positions,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let body = UncutBody::new(&mesh);
+    let state = body.state(&mesh.rest_positions);
     let mut r = OffscreenRenderer::new(&dev, &mesh, &skin, SIZE, 1).unwrap();
     let view = vertical_view(true);
     // 6 cm square, 3 cm above the plate, facing the camera (+z).
@@ -386,15 +364,8 @@ fn the_panel_shows_its_image_the_right_way_round_over_the_scene() {
 fn both_stereo_eyes_draw_the_line() {
     let Some(dev) = device() else { return };
     let (mesh, skin) = plate();
-    let cut = CutState::new(&mesh);
-    let vm = vec![0.0; mesh.tet_count()];
-    let state = BodyState {
-        positions: &mesh.rest_positions,
-        device_positions: None,
-        cut: &cut,
-        von_mises: &vm,
-        pinned: &[],
-    };
+    let body = UncutBody::new(&mesh);
+    let state = body.state(&mesh.rest_positions);
     let centre = vertical_view(true);
     let eyes: Vec<View> = [-0.03f32, 0.03]
         .iter()
