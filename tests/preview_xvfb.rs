@@ -22,29 +22,25 @@ fn required() -> bool {
     std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
 }
 
-#[test]
-fn preview_opens_a_window_renders_and_exits_after_n_frames() {
+/// `incise preview ARGS --device cpu --screenshot F` under Xvfb; the screenshot, or `None`
+/// (the test is skipped, saying why) without xvfb-run or a GPU adapter unless
+/// `INCISE_REQUIRE_GPU=1`.
+fn preview_screenshot(name: &str, args: &[&str]) -> Option<RgbaImage> {
     if Command::new("xvfb-run").arg("--help").output().is_err() {
         assert!(
             !required(),
             "INCISE_REQUIRE_GPU=1 but xvfb-run is missing (apt-get install xvfb)"
         );
         eprintln!("skipping: xvfb-run is not installed");
-        return;
+        return None;
     }
-    let dir = temp_dir("xvfb");
+    let dir = temp_dir(name);
     let shot = dir.join("window.png");
     let o = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 1024x768x24"])
         .arg(env!("CARGO_BIN_EXE_incise"))
-        .args([
-            "preview",
-            "config/beam_sag.ron",
-            "--frames",
-            "30",
-            "--size",
-            "640x480",
-        ])
+        .arg("preview")
+        .args(args)
         .args(["--device", "cpu", "--screenshot"])
         .arg(&shot)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
@@ -54,10 +50,20 @@ fn preview_opens_a_window_renders_and_exits_after_n_frames() {
     let err = String::from_utf8_lossy(&o.stderr);
     if !o.status.success() && err.contains("no GPU adapter") && !required() {
         eprintln!("skipping: {err}");
-        return;
+        return None;
     }
     assert!(o.status.success(), "preview failed: {err}");
-    let img = RgbaImage::load_png(&shot).unwrap();
+    Some(RgbaImage::load_png(&shot).unwrap())
+}
+
+#[test]
+fn preview_opens_a_window_renders_and_exits_after_n_frames() {
+    let Some(img) = preview_screenshot(
+        "xvfb",
+        &["config/beam_sag.ron", "--frames", "30", "--size", "640x480"],
+    ) else {
+        return;
+    };
     assert_eq!((img.width, img.height), (640, 480));
     // The panel (egui's dark grey) on the left, the scene's background and the beam's
     // skin on the right: the window holds more than one flat colour.
@@ -167,38 +173,19 @@ wait $P"#,
 
 #[test]
 fn an_exercise_draws_its_plan_on_the_tissue() {
-    if Command::new("xvfb-run").arg("--help").output().is_err() {
-        assert!(!required(), "INCISE_REQUIRE_GPU=1 but xvfb-run is missing");
-        eprintln!("skipping: xvfb-run is not installed");
-        return;
-    }
-    let dir = temp_dir("xvfb-exercise");
-    let shot = dir.join("exercise.png");
-    let o = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24"])
-        .arg(env!("CARGO_BIN_EXE_incise"))
-        .args([
-            "preview",
+    let Some(img) = preview_screenshot(
+        "xvfb-exercise",
+        &[
             "--exercise",
             "config/exercises/slab_depth.ron",
             "--frames",
             "10",
             "--size",
             "900x600",
-        ])
-        .args(["--device", "cpu", "--screenshot"])
-        .arg(&shot)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("XDG_RUNTIME_DIR", &dir)
-        .output()
-        .expect("xvfb-run runs");
-    let err = String::from_utf8_lossy(&o.stderr);
-    if !o.status.success() && err.contains("no GPU adapter") && !required() {
-        eprintln!("skipping: {err}");
+        ],
+    ) else {
         return;
-    }
-    assert!(o.status.success(), "preview failed: {err}");
-    let img = RgbaImage::load_png(&shot).unwrap();
+    };
     // The violet marker line (blue well above green, red between) in the 3D view, right
     // of the panel: a 3 cm line 1 mm wide.
     let violet = (0..img.height)
