@@ -7,7 +7,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{incise, temp_dir, text};
+use common::{incise, score_stroke, temp_dir, text};
 use glam::{Quat, Vec3};
 use incise_scalpel::{PoseKey, Stroke, load_tool};
 use serde_json::Value;
@@ -127,20 +127,7 @@ fn attempt(dir: &Path, name: &str, exercise: &str, s: &Stroke) -> Value {
     let path = dir.join(format!("{name}.ron"));
     s.save(&path).unwrap();
     let out = dir.join(name);
-    let o = incise(&[
-        "exercise",
-        exercise,
-        "--stroke",
-        path.to_str().unwrap(),
-        "--device",
-        "cpu",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-        "--history",
-        dir.join("history.jsonl").to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = score_stroke(exercise, &path, &out, &dir.join("history.jsonl"));
     assert!(out.join("report.html").is_file());
     let r: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("result.json")).unwrap()).unwrap();

@@ -8,7 +8,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{incise, temp_dir, text};
+use common::{score_stroke, temp_dir};
 use incise::body::Body;
 use incise::exercise::LiveExercise;
 use incise::preview::hand_tool::HandTool;
@@ -106,20 +106,7 @@ fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
 
     // `incise exercise` on the saved stroke: the same score from the same tets.
     let replay = dir.join("replay");
-    let o = incise(&[
-        "exercise",
-        EXERCISE,
-        "--stroke",
-        done.stroke.to_str().unwrap(),
-        "--device",
-        "cpu",
-        "--quiet",
-        "--out",
-        replay.to_str().unwrap(),
-        "--history",
-        history.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+    score_stroke(EXERCISE, &done.stroke, &replay, &history);
     let cli = json(&replay.join("result.json"));
     let report = json(&replay.join("report.json"));
     let cli_released: Vec<u64> = report["released_tets"]

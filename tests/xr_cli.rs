@@ -7,7 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{incise, temp_dir, text};
+use common::{incise, score_stroke, temp_dir, text};
 use glam::{Quat, Vec3};
 use incise_xr::RgbaImage;
 use serde_json::Value;
@@ -430,20 +430,12 @@ fn an_exercise_in_the_headset_is_scored_on_a_and_shows_its_card() {
     let live: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap();
     let replay = out.join("replay");
-    let o = incise(&[
-        "exercise",
+    score_stroke(
         "config/exercises/slab_depth.ron",
-        "--stroke",
-        dir.join("stroke.ron").to_str().unwrap(),
-        "--device",
-        "cpu",
-        "--quiet",
-        "--out",
-        replay.to_str().unwrap(),
-        "--history",
-        out.join("replay_history.jsonl").to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
+        &dir.join("stroke.ron"),
+        &replay,
+        &out.join("replay_history.jsonl"),
+    );
     let replayed: Value =
         serde_json::from_str(&std::fs::read_to_string(replay.join("result.json")).unwrap())
             .unwrap();

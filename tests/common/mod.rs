@@ -1,7 +1,7 @@
 //! Helpers shared by the end-to-end tests: run the `incise` binary, scratch folders, text.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Run the built `incise` binary from the workspace root with `args`.
@@ -31,4 +31,24 @@ pub fn incise_command(args: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_incise"));
     c.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
     c
+}
+
+/// `incise exercise EXERCISE --stroke STROKE --device cpu --quiet --out OUT --history
+/// HISTORY`, which must succeed; its output (result.json, report.json, … are in `out`).
+pub fn score_stroke(exercise: &str, stroke: &Path, out: &Path, history: &Path) -> Output {
+    let o = incise(&[
+        "exercise",
+        exercise,
+        "--stroke",
+        stroke.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--history",
+        history.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    o
 }
