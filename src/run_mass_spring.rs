@@ -25,7 +25,7 @@ use incise_sim::{Material, TetMesh};
 use crate::report::{
     EdgeFrameStats, FrameData, FrameRecord, HapticInfo, MaterialInfo, MeshInfo, Report,
 };
-use crate::run::{RunOptions, RunOutcome};
+use crate::run::{RunEnd, RunOptions, RunOutcome};
 use crate::scene::{MassSpringScene, MaterialChoice, Scene, StrokeSpec, load_materials, raw_mesh};
 
 /// Run the mass-spring scene `scene` (with model settings `ms`) as `opts` asks.
@@ -147,33 +147,17 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
     report.mesh.tets = after.tets;
     report.mesh.skin_vertices = after.nodes;
     report.mesh.skin_triangles = after.triangles;
-    let interrupted = crate::interrupt::requested();
-    report.status = if interrupted {
-        "interrupted"
-    } else {
-        "completed"
-    }
-    .into();
-    let report_path = opts.out.join("report.json");
-    report.write(&report_path)?;
-    if interrupted {
-        return Err(crate::interrupt::Interrupted {
-            what: opts.scene.display().to_string(),
-            frames: report.frames.len() as u64,
-            out: opts.out.display().to_string(),
-        }
-        .into());
-    }
-    if !opts.quiet {
+    // Ctrl-C stops the frame loops; the run then ends as every runner does.
+    let stopped = crate::interrupt::requested().then_some(RunEnd::Interrupted {
+        frames: report.frames.len() as u64,
+    });
+    if !opts.quiet && stopped.is_none() {
         eprintln!(
             "mass-spring: {} nodes, {} tets, {} edges after {} frames",
             after.nodes, after.tets, after.edges, frames
         );
     }
-    Ok(RunOutcome {
-        report_path,
-        report,
-    })
+    crate::run::finish(report, opts.out.join("report.json"), stopped, opts)
 }
 
 /// The ordinary run: cut along the stroke and step the model frame by frame; returns it.
