@@ -186,7 +186,7 @@ impl Screenshots {
             .collect();
         let mut state = BodyState::of_solver(solver, &self.pinned);
         if let (Body::Gpu(g), true) = (body, self.shared_device) {
-            state.device_positions = Some(g.position_buffer());
+            state.device_displacements = Some(g.displacement_buffer());
         }
         Ok(self
             .offscreen

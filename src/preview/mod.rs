@@ -403,7 +403,7 @@ impl Live {
         let solver = self.session.body.solver();
         let mut state = BodyState::of_solver(solver, &self.session.pinned);
         if let Body::Gpu(g) = &self.session.body {
-            state.device_positions = Some(g.position_buffer());
+            state.device_displacements = Some(g.displacement_buffer());
         }
         let settings = RenderSettings {
             overlays: self.panel.overlays,

@@ -10,9 +10,10 @@ use incise_sim::{Solver, TetMesh};
 pub struct BodyState<'a> {
     /// Node positions on the host (the CPU solver's, or the GPU solver's mirror), m.
     pub positions: &'a [Vec3],
-    /// The same positions already on the render device (`vec4<f32>` per node, as the GPU
-    /// solver keeps them): copied on the device instead of uploading `positions`.
-    pub device_positions: Option<&'a wgpu::Buffer>,
+    /// The nodes' displacements from their rest positions already on the render device
+    /// (`vec4<f32>` per node, xyz = `u`, as the GPU solver keeps them): the renderer adds
+    /// the rest positions on the device instead of uploading `positions`.
+    pub device_displacements: Option<&'a wgpu::Buffer>,
     /// Live tets, visible faces and their changes.
     pub cut: &'a CutState,
     /// von Mises stress per tet (mesh order), Pa.
@@ -27,7 +28,7 @@ impl<'a> BodyState<'a> {
     pub fn of_solver(solver: &'a Solver, pinned: &'a [u32]) -> Self {
         BodyState {
             positions: solver.positions(),
-            device_positions: None,
+            device_displacements: None,
             cut: solver.cut(),
             von_mises: solver.von_mises(),
             pinned,
@@ -55,7 +56,7 @@ impl UncutBody {
     pub fn state<'a>(&'a self, positions: &'a [Vec3]) -> BodyState<'a> {
         BodyState {
             positions,
-            device_positions: None,
+            device_displacements: None,
             cut: &self.cut,
             von_mises: &self.von_mises,
             pinned: &[],

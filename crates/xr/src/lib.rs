@@ -17,6 +17,7 @@ pub mod error;
 pub mod frame;
 mod gpu_skin;
 pub mod image_io;
+mod node_world;
 pub mod offscreen;
 pub mod openxr;
 mod panel;

@@ -11,6 +11,7 @@ use incise_sim::mesh::{NO_NEIGHBOR, TET_EDGES, TET_FACES};
 use incise_sim::skin::Skin;
 
 use crate::frame::{BodyState, RenderSettings};
+use crate::node_world::NodeWorld;
 use crate::ribbon::{self, LineVertex};
 
 /// Bytes between the per-view globals (the uniform-offset alignment every adapter accepts).
@@ -123,6 +124,8 @@ pub(crate) struct SceneBuffers {
     faces_built_for: Option<usize>,
     /// Released-tet count the wireframe edges were built for.
     edges_built_for: Option<usize>,
+    /// Adds the rest positions to device displacements.
+    node_world: NodeWorld,
     host_nodes: Vec<[f32; 4]>,
     host_lines: Vec<LineVertex>,
 }
@@ -226,6 +229,7 @@ impl SceneBuffers {
             pin_radius: 0.3 * edge_sum / edge_count,
             faces_built_for: None,
             edges_built_for: None,
+            node_world: NodeWorld::new(device, mesh),
             host_nodes: Vec::new(),
             host_lines: Vec::new(),
         }
@@ -270,8 +274,8 @@ impl SceneBuffers {
         })
     }
 
-    /// Bring the device copies up to date with `state`; node positions from the device
-    /// are copied by `encoder`.
+    /// Bring the device copies up to date with `state`; node world positions from device
+    /// displacements are computed by a pass recorded into `encoder`.
     pub fn update(
         &mut self,
         device: &wgpu::Device,
@@ -281,9 +285,9 @@ impl SceneBuffers {
         settings: &RenderSettings,
     ) {
         let n = self.node_count.min(state.positions.len());
-        match state.device_positions {
+        match state.device_displacements {
             Some(src) if src.size() >= self.node_count as u64 * 16 => {
-                encoder.copy_buffer_to_buffer(src, 0, &self.nodes, 0, self.node_count as u64 * 16);
+                self.node_world.record(device, encoder, src, &self.nodes);
             }
             _ => {
                 self.host_nodes.clear();

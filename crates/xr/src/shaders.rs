@@ -14,8 +14,9 @@ pub const RENDER_SHADERS: [&str; 7] = [
     "panel",
 ];
 
-/// Compute shaders of the skin deformation (each `shaders/<name>.wgsl`).
-pub const COMPUTE_SHADERS: [&str; 2] = ["skin_deform", "skin_normals"];
+/// Compute shaders of the node world positions and the skin deformation (each
+/// `shaders/<name>.wgsl`).
+pub const COMPUTE_SHADERS: [&str; 3] = ["node_world", "skin_deform", "skin_normals"];
 
 /// Full WGSL source of a renderer shader, or `None` if unknown.
 pub fn source(name: &str) -> Option<String> {
@@ -28,6 +29,7 @@ pub fn source(name: &str) -> Option<String> {
         "tool" => render(include_str!("../../../shaders/tool.wgsl")),
         "surface_line" => render(include_str!("../../../shaders/surface_line.wgsl")),
         "panel" => render(include_str!("../../../shaders/panel.wgsl")),
+        "node_world" => include_str!("../../../shaders/node_world.wgsl").to_string(),
         "skin_deform" => include_str!("../../../shaders/skin_deform.wgsl").to_string(),
         "skin_normals" => include_str!("../../../shaders/skin_normals.wgsl").to_string(),
         _ => return None,

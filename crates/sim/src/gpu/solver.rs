@@ -481,10 +481,10 @@ impl GpuSolver {
         self.last_timing
     }
 
-    /// The device's node buffer (`vec4<f32>` per node: xyz = displacement from the rest
-    /// position, w = inverse mass), for renderers that read the state without a round
-    /// trip: world position = rest position + displacement.
-    pub fn position_buffer(&self) -> &wgpu::Buffer {
+    /// The device's node buffer (`vec4<f32>` per node: xyz = displacement `u` from the
+    /// rest position, w = inverse mass), for renderers that read the state without a
+    /// round trip: world position = rest position + `u`.
+    pub fn displacement_buffer(&self) -> &wgpu::Buffer {
         &self.buf.pos
     }
 
