@@ -232,7 +232,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
         if (d < P.reach) {
-            near_edge[i] = 1u;
+            near_edge[i] = 3u; // this frame and this release window (release.wgsl)
         }
     }
 }

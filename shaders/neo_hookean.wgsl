@@ -1,7 +1,9 @@
 // Neo-Hookean constraint projection of one colour (PHYSICS.md §1.2, Macklin & Müller 2021):
-// C_D = ||F||_F, C_H = det F - gamma, coupled 2x2 solve (default) or H then D. Tets of one
-// colour share no node, so each invocation owns its four nodes.
-// CPU twin: crates/sim/src/xpbd/neo_hookean.rs (same operations in the same order).
+// the rest-free pair C_H = ln J, C_D = sqrt(I_C - 3 - 2 ln J) (P.pair 0, default) or the
+// seed's C_D = ||F||_F, C_H = det F - gamma (P.pair 1); coupled 2x2 solve (default) or H
+// then D. Tets of one colour share no node, so each invocation owns its four nodes.
+// CPU twins: crates/sim/src/xpbd/rest_free.rs and neo_hookean.rs (same operations in the
+// same order).
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read_write> pos: array<vec4<f32>>;
@@ -111,6 +113,96 @@ fn project_sequential(dm_inv: mat3x3<f32>, alpha_h: f32, alpha_d: f32) -> f32 {
     return dl_h;
 }
 
+// A constraint value and its gradient dC/dF; c < 0 marks "no direction" (C_D at rest).
+struct Term {
+    c: f32,
+    g: mat3x3<f32>,
+}
+
+// Rest-free C_H = L(J), dC_H/dF = L'(J) cof F.
+fn rf_volume(s: Strain) -> Term {
+    let l = log_volume(s);
+    return Term(l.x, cof_f(s) * l.y);
+}
+
+// Rest-free C_D = sqrt(I_C - 3 - 2 L(J)), dC_D/dF = (F - L' cof F) / C_D.
+fn rf_shape(s: Strain) -> Term {
+    let j = 1.0 + s.j1;
+    var psi: f32;
+    var half: mat3x3<f32>;
+    if (j > J_MIN) {
+        psi = h_norm2(s) - 2.0 * s.i2 - 2.0 * s.det_h + 2.0 * log1p_excess(s.j1);
+        half = j_f_minus_cof(s) * (1.0 / j);
+    } else {
+        let l = log_volume(s);
+        psi = 2.0 * s.tr + h_norm2(s) - 2.0 * l.x;
+        half = (IDENTITY3 + s.h) - cof_f(s) * l.y;
+    }
+    let c = sqrt(max(psi, 0.0));
+    if (c < 1e-10) {
+        return Term(-1.0, half);
+    }
+    return Term(c, half * (1.0 / c));
+}
+
+fn current_strain(dm_inv: mat3x3<f32>) -> Strain {
+    return strain_of(displacement_gradient(x[0], x[1], x[2], x[3], dm_inv));
+}
+
+fn project_rest_free_coupled(dm_inv: mat3x3<f32>, alpha_h: f32, alpha_d: f32) -> f32 {
+    let s = current_strain(dm_inv);
+    let shape = rf_shape(s);
+    let with_volume = alpha_h >= 0.0;
+    let vol = rf_volume(s);
+    gradients_a(vol.g, dm_inv);
+    if (shape.c < 0.0) {
+        if (with_volume) {
+            return apply_scalar_a(vol.c, alpha_h);
+        }
+        return 0.0;
+    }
+    gradients_b(shape.g, dm_inv);
+    if (!with_volume) {
+        gradients_a(shape.g, dm_inv);
+        apply_scalar_a(shape.c, alpha_d);
+        return 0.0;
+    }
+    var a = dot_aa() + alpha_h;
+    var b = dot_ab();
+    var d = dot_bb() + alpha_d;
+    let sc = 1.0 / (a + d);
+    a *= sc;
+    b *= sc;
+    d *= sc;
+    let det = a * d - b * b;
+    if (!(det > 0.0)) {
+        return 0.0;
+    }
+    let r1 = -vol.c * sc;
+    let r2 = -shape.c * sc;
+    let dl_h = (r1 * d - b * r2) / det;
+    let dl_d = (a * r2 - b * r1) / det;
+    for (var i = 0; i < 4; i++) {
+        x[i] += w[i] * (g_a[i] * dl_h + g_b[i] * dl_d);
+    }
+    return dl_h;
+}
+
+fn project_rest_free_sequential(dm_inv: mat3x3<f32>, alpha_h: f32, alpha_d: f32) -> f32 {
+    var dl_h = 0.0;
+    if (alpha_h >= 0.0) {
+        let vol = rf_volume(current_strain(dm_inv));
+        gradients_a(vol.g, dm_inv);
+        dl_h = apply_scalar_a(vol.c, alpha_h);
+    }
+    let shape = rf_shape(current_strain(dm_inv));
+    if (shape.c >= 0.0) {
+        gradients_a(shape.g, dm_inv);
+        apply_scalar_a(shape.c, alpha_d);
+    }
+    return dl_h;
+}
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= S.count) {
@@ -129,7 +221,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r = rest[slot];
     let dm_inv = dm_inv_of(r);
     var dl_h: f32;
-    if (P.mode == 0u) {
+    if (P.pair == 0u && P.mode == 0u) {
+        dl_h = project_rest_free_coupled(dm_inv, r.c0.w, r.c1.w);
+    } else if (P.pair == 0u) {
+        dl_h = project_rest_free_sequential(dm_inv, r.c0.w, r.c1.w);
+    } else if (P.mode == 0u) {
         dl_h = project_coupled(dm_inv, r.c0.w, r.c1.w);
     } else {
         dl_h = project_sequential(dm_inv, r.c0.w, r.c1.w);

@@ -1,8 +1,10 @@
-// Per-tet stress (PHYSICS.md §1.3): rotation by Müller et al. 2016 (warm-started), Cauchy
-// stress sigma_T = mu((R^T F + F^T R)/2 - I) + lambda_H/(h^2 V) I and von Mises
-// sqrt(3/2)||dev sigma_T||_F (the hydrostatic part drops out of the deviator, so the
-// kernel needs no lambda_H); also det F for the inversion guard.
-// CPU twin: crates/sim/src/stress/ and Solver::update_stress_and_check.
+// Per-tet stress: the Cauchy stress of the model's energy (P.measure 0, default;
+// docs/physics-notes.md "True stress": dev sigma = (mu/J) dev(F F^T), so von Mises needs no
+// pressure and no rotation), or the seed's eq. 3 (PHYSICS.md §1.3: rotation by Müller et
+// al. 2016, warm-started, sigma_T = mu((R^T F + F^T R)/2 - I) + lambda_H/(h^2 V) I, whose
+// hydrostatic part drops out of the deviator); von Mises sqrt(3/2)||dev sigma||_F; also
+// det F for the inversion guard.
+// CPU twin: crates/sim/src/stress/ and Solver::compute_stress.
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
@@ -71,6 +73,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let idx = tets[slot];
     let r = rest[slot];
+    if (P.measure == 0u) {
+        let s = strain_of(displacement_gradient(pos[idx[0]].xyz, pos[idx[1]].xyz, pos[idx[2]].xyz, pos[idx[3]].xyz, dm_inv_of(r)));
+        let j = 1.0 + s.j1;
+        // The pressure is isotropic: it leaves the deviator, so von Mises is that of
+        // (mu/J)(F F^T - I) (CPU twin: cauchy_stress + von_mises).
+        let shape = b_minus_i(s) * (P.mu / max(j, J_MIN));
+        let mean = (shape[0].x + shape[1].y + shape[2].z) / 3.0;
+        let dev = shape - IDENTITY3 * mean;
+        von_mises[slot] = sqrt(1.5 * (dot(dev[0], dev[0]) + dot(dev[1], dev[1]) + dot(dev[2], dev[2])));
+        det_f[slot] = j;
+        return;
+    }
     let f = deformation_gradient(pos[idx[0]].xyz, pos[idx[1]].xyz, pos[idx[2]].xyz, pos[idx[3]].xyz, dm_inv_of(r));
     let q = extract_rotation(f, rotation[slot]);
     let rm = quat_to_mat(q);

@@ -323,7 +323,8 @@ impl Panel {
         );
         done |= slider(
             ui,
-            egui::Slider::new(&mut d.poisson_ratio, 0.0..=0.49).text("ν"),
+            egui::Slider::new(&mut d.poisson_ratio, d.poisson_range.0..=d.poisson_range.1)
+                .text("ν"),
         );
         done |= slider(
             ui,

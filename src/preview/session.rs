@@ -31,6 +31,8 @@ pub struct LiveParams {
     pub cut_threshold: Option<f32>,
     /// Substeps per frame.
     pub substeps: u32,
+    /// The Poisson ratios the scene's constraint pair can represent (not editable).
+    pub poisson_range: (f32, f32),
 }
 
 /// A scene running in the preview.
@@ -87,6 +89,7 @@ impl Session {
             damping: p.damping,
             cut_threshold: p.release_threshold,
             substeps: p.substeps,
+            poisson_range: p.poisson_range(),
         };
         let pinned = incise_xr::frame::pinned_nodes(&built.solver);
         Ok(Session {

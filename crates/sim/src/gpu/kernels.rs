@@ -34,12 +34,16 @@ pub(crate) struct Kernels {
     pub velocity: wgpu::ComputePipeline,
     pub stress: wgpu::ComputePipeline,
     pub release: wgpu::ComputePipeline,
+    /// `release.wgsl`'s `clear_window`: restart the cut-zone window after a check.
+    pub clear_window: wgpu::ComputePipeline,
+    /// `release.wgsl`'s `clear_frame`: clear the frame's near-edge bit.
+    pub clear_frame: wgpu::ComputePipeline,
 }
 
 impl Kernels {
     /// Compile every stage (layouts are derived from the shaders).
     pub fn new(device: &wgpu::Device) -> Self {
-        let make = |stage: &str| {
+        let make_entry = |stage: &str, entry: &str| {
             let src = shader_source(stage).unwrap_or_default();
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(stage),
@@ -49,11 +53,12 @@ impl Kernels {
                 label: Some(stage),
                 layout: None,
                 module: &module,
-                entry_point: Some("main"),
+                entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: None,
             })
         };
+        let make = |stage: &str| make_entry(stage, "main");
         Kernels {
             predict: make("predict"),
             project: make("neo_hookean"),
@@ -61,6 +66,8 @@ impl Kernels {
             velocity: make("velocity"),
             stress: make("stress"),
             release: make("release"),
+            clear_window: make_entry("release", "clear_window"),
+            clear_frame: make_entry("release", "clear_frame"),
         }
     }
 }

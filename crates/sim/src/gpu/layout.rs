@@ -21,7 +21,9 @@ pub(crate) struct Params {
     pub box_count: u32,
     pub friction: f32,
     pub reach: f32,
-    pub pad: [u32; 3],
+    pub lambda: f32,
+    pub pair: u32,
+    pub measure: u32,
 }
 
 /// `Step` (uniform, 16 bytes, bound at 256-byte aligned offsets).

@@ -13,7 +13,10 @@ use super::layout::{
 use super::{GpuContext, GpuError};
 use crate::Solver;
 use crate::contact::{ContactTool, CutZone, PlacedTool, ToolPose};
-use crate::xpbd::{FrameStats, NodeKind, SolverError, TetProjection};
+use crate::stress::StressMeasure;
+use crate::xpbd::{
+    ConstraintPair, FrameStats, NodeKind, SolverError, TetProjection, release_checks,
+};
 
 const WG: u32 = 64;
 
@@ -37,6 +40,7 @@ struct Buffers {
     tets: wgpu::Buffer,
     rest: wgpu::Buffer,
     live: wgpu::Buffer,
+    saved_live: wgpu::Buffer,
     lambda: wgpu::Buffer,
     von_mises: wgpu::Buffer,
     det_f: wgpu::Buffer,
@@ -62,6 +66,8 @@ struct Bindings {
     velocity: wgpu::BindGroup,
     stress: wgpu::BindGroup,
     release: wgpu::BindGroup,
+    clear_window: wgpu::BindGroup,
+    clear_frame: wgpu::BindGroup,
 }
 
 /// Mappable copies of what the host reads each frame.
@@ -184,7 +190,8 @@ impl GpuSolver {
                 let m = s.terms.dm_inv;
                 let v = host.mesh.rest_volume[host.tet_of_slot[i] as usize];
                 TetRest {
-                    c0: [m.x_axis.x, m.x_axis.y, m.x_axis.z, s.terms.alpha_h],
+                    // No volume constraint (λ = 0, infinite compliance): −1 on the device.
+                    c0: [m.x_axis.x, m.x_axis.y, m.x_axis.z, finite_or_none(s.terms.alpha_h)],
                     c1: [m.y_axis.x, m.y_axis.y, m.y_axis.z, s.terms.alpha_d],
                     c2: [m.z_axis.x, m.z_axis.y, m.z_axis.z, v],
                 }
@@ -267,6 +274,7 @@ impl GpuSolver {
             tets: storage(&device, "tets", bytemuck::cast_slice(&tets), none),
             rest: storage(&device, "rest", bytemuck::cast_slice(&rest), none),
             live: storage(&device, "live", bytemuck::cast_slice(&live), none),
+            saved_live: storage(&device, "saved live", bytemuck::cast_slice(&live), none),
             lambda: storage(&device, "lambda_h", &vec![0u8; slots * 4], none),
             von_mises: storage(&device, "von mises", &vec![0u8; slots * 4], none),
             det_f: storage(
@@ -377,6 +385,8 @@ impl GpuSolver {
                 ],
                 "release",
             ),
+            clear_window: near_edge_group(&device, &kernels.clear_window, b),
+            clear_frame: near_edge_group(&device, &kernels.clear_frame, b),
         };
         let read = Readback {
             pos: staging(&device, "read pos", n as u64 * 16),
@@ -509,12 +519,13 @@ impl GpuSolver {
         let (n, slots) = (self.host.x.len() as u64, self.host.slots.len() as u64);
         enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.buf.saved_pos, 0, n * 16);
         enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.buf.saved_vel, 0, n * 16);
+        enc.copy_buffer_to_buffer(&self.buf.live, 0, &self.buf.saved_live, 0, slots * 4);
         enc.clear_buffer(&self.buf.released_count, 0, None);
         let with_tool = self.host.tool.is_some();
         if with_tool {
             enc.clear_buffer(&self.buf.push, 0, None);
-            enc.clear_buffer(&self.buf.near_edge, 0, None);
         }
+
         self.record_frame(&mut enc);
         if with_tool {
             enc.copy_buffer_to_buffer(&self.buf.push, 0, &self.read.push, 0, n * 16);
@@ -644,6 +655,14 @@ impl GpuSolver {
             timestamp_writes,
         });
         let k = &self.kernels;
+        let p = &self.host.params;
+        let checks = release_checks(self.host.time, p.substep(), p.substeps, p.release_interval);
+        let mut fresh = false;
+        // The frame's bit of the near-edge flags clears with or without a tool (the release
+        // window's bit carries over to the next check).
+        pass.set_pipeline(&k.clear_frame);
+        pass.set_bind_group(0, &self.bind.clear_frame, &[]);
+        pass.dispatch_workgroups(groups(n), 1, 1);
         for s in 0..self.host.params.substeps as usize {
             pass.set_pipeline(&k.predict);
             pass.set_bind_group(0, &self.bind.predict, &[]);
@@ -664,14 +683,36 @@ impl GpuSolver {
             pass.set_pipeline(&k.velocity);
             pass.set_bind_group(0, &self.bind.velocity, &[]);
             pass.dispatch_workgroups(groups(n), 1, 1);
+            fresh = checks.contains(&(s as u32));
+            if fresh {
+                self.record_release_check(&mut pass);
+            }
         }
-        pass.set_pipeline(&k.stress);
+        if !fresh {
+            // Stress and det F at the end of the frame, for the guards and the report.
+            self.record_stress(&mut pass);
+        }
+    }
+
+    fn record_stress(&self, pass: &mut wgpu::ComputePass<'_>) {
+        pass.set_pipeline(&self.kernels.stress);
         pass.set_bind_group(0, &self.bind.stress, &[]);
         pass.dispatch_workgroups(groups(self.host.slots.len()), 1, 1);
-        pass.set_pipeline(&k.release);
+    }
+
+    /// Stress, release and the restart of the cut-zone window (PHYSICS.md §1.4 on the
+    /// fixed interval; CPU twin: the check in `Solver::run_substeps`).
+    fn record_release_check(&self, pass: &mut wgpu::ComputePass<'_>) {
+        self.record_stress(pass);
+        pass.set_pipeline(&self.kernels.release);
         pass.set_bind_group(0, &self.bind.release, &[]);
         pass.dispatch_workgroups(groups(self.host.slots.len()), 1, 1);
+        pass.set_pipeline(&self.kernels.clear_window);
+        pass.set_bind_group(0, &self.bind.clear_window, &[]);
+        pass.dispatch_workgroups(groups(self.host.x.len()), 1, 1);
     }
+
+
 
     /// Map the staging buffers, copy into the host mirror; returns released slots.
     fn read_back(&mut self) -> Result<Vec<u32>, GpuError> {
@@ -718,7 +759,7 @@ impl GpuSolver {
             let near: &[u32] = bytemuck::cast_slice(&near);
             for (i, (p, e)) in push.iter().zip(near).enumerate() {
                 self.host.contact_push[i] = Vec3::new(p[0], p[1], p[2]);
-                self.host.near_edge[i] = *e != 0;
+                self.host.near_edge[i] = *e & 1 != 0;
             }
         } else {
             self.host
@@ -766,6 +807,8 @@ impl GpuSolver {
             });
         enc.copy_buffer_to_buffer(&self.buf.saved_pos, 0, &self.buf.pos, 0, n * 16);
         enc.copy_buffer_to_buffer(&self.buf.saved_vel, 0, &self.buf.vel, 0, n * 16);
+        let slots = self.host.slots.len() as u64;
+        enc.copy_buffer_to_buffer(&self.buf.saved_live, 0, &self.buf.live, 0, slots * 4);
         enc.copy_buffer_to_buffer(&self.buf.saved_pos, 0, &self.read.pos, 0, n * 16);
         enc.copy_buffer_to_buffer(&self.buf.saved_vel, 0, &self.read.vel, 0, n * 16);
         self.queue.submit([enc.finish()]);
@@ -850,8 +893,43 @@ fn params_of(host: &Solver) -> Params {
             CutZone::NearEdge { reach } => reach,
             CutZone::Anywhere => -1.0,
         },
-        pad: [0; 3],
+        lambda: host.volume_stiffness(),
+        pair: match p.constraints {
+            ConstraintPair::RestFree => 0,
+            ConstraintPair::GammaShifted => 1,
+        },
+        measure: match p.stress {
+            StressMeasure::Cauchy => 0,
+            StressMeasure::PaperEq3 => 1,
+        },
     }
+}
+
+/// Bind group of a near-edge clearing kernel (`Params` at 0, `near_edge` at 6).
+fn near_edge_group(
+    device: &wgpu::Device,
+    pipeline: &wgpu::ComputePipeline,
+    b: &Buffers,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("near edge"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: b.params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 6,
+                resource: b.near_edge.as_entire_binding(),
+            },
+        ],
+    })
+}
+
+/// A compliance for the device: infinite (no constraint) becomes −1.
+fn finite_or_none(alpha: f32) -> f32 {
+    if alpha.is_finite() { alpha } else { -1.0 }
 }
 
 /// Append one pose block of the `tool` buffer (layout in `shaders/contact.wgsl`).

@@ -1,7 +1,10 @@
-//! Per-tet stress: polar decomposition, Cauchy stress σ_T and von Mises (PHYSICS.md §1.3).
+//! Per-tet stress: the Cauchy stress of the model (default) or the seed's eq. 3 with its
+//! polar decomposition; von Mises (PHYSICS.md §1.3).
 
+mod cauchy;
 mod polar;
 mod von_mises;
 
+pub use cauchy::{StressMeasure, cauchy_stress, mean_stress, von_mises};
 pub use polar::extract_rotation;
 pub use von_mises::{TetStress, tet_stress};

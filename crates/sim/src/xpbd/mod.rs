@@ -4,13 +4,21 @@ mod coloring;
 mod frame;
 mod neo_hookean;
 mod params;
+mod release_schedule;
+mod rest_free;
 mod shared_nodes;
 mod solver;
 mod stability;
+mod strain;
 
 pub use coloring::greedy_tet_colors;
 pub use frame::FrameStats;
-pub use neo_hookean::{TetProjection, TetTerms, deformation_gradient, det_gradient, project_tet};
-pub use params::{SolverError, SolverParams};
+pub use neo_hookean::{
+    ConstraintPair, TetProjection, TetTerms, deformation_gradient, det_gradient, project_tet,
+};
+pub use release_schedule::release_checks;
+pub use rest_free::{J_MIN, log_volume, shape_constraint, shape_energy, volume_constraint};
+pub use strain::{Strain, cofactor, displacement_gradient, log1p_excess};
+pub use params::{DEFAULT_RELEASE_INTERVAL, SolverError, SolverParams};
 pub use solver::{NodeKind, Solver};
 pub use stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};

@@ -1,5 +1,7 @@
 //! Projection of the Neo-Hookean tet constraints (PHYSICS.md §1.2, Macklin & Müller 2021).
 //!
+//! Two constraint pairs ([`ConstraintPair`]): the rest-free pair (default,
+//! [`super::rest_free`]) and the seed paper's γ-shifted pair, written here:
 //! `C_D = ‖F‖_F` with compliance `1/(μV)` and `C_H = det F − γ`, `γ = 1 + μ/λ`, with
 //! compliance `1/(λV)`. The CPU reference solves both constraints of a tet together (a 2×2
 //! system, as Macklin & Müller 2021 §5 recommend): because `∇C_H ∥ ∇C_D` at rest, the
@@ -10,6 +12,18 @@
 use glam::{Mat3, Vec3};
 
 use crate::mesh::shape_matrix;
+
+/// Which pair of Neo-Hookean constraints a tet carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum ConstraintPair {
+    /// `C_H = ln J`, `C_D = sqrt(I_C − 3 − 2 ln J)`: zero energy, force and multiplier at
+    /// rest for every ν in [0, 0.5) (default; docs/physics-notes.md).
+    #[default]
+    RestFree,
+    /// `C_H = det F − γ`, `C_D = ‖F‖_F` as the seed paper and PHYSICS.md §1.2 write it:
+    /// both carry a multiplier at rest, which bounds the substep (stiffness number ≤ 1).
+    GammaShifted,
+}
 
 /// How the two constraints of one tet are projected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -65,7 +79,7 @@ pub fn det_gradient(f: &Mat3) -> Mat3 {
 /// `∇x0 = −(∇x1+∇x2+∇x3)`.
 // PHYSICS.md §1.2, vertex gradients.
 #[inline]
-fn vertex_gradients(dcdf: Mat3, dm_inv: &Mat3) -> [Vec3; 4] {
+pub(super) fn vertex_gradients(dcdf: Mat3, dm_inv: &Mat3) -> [Vec3; 4] {
     let g = dcdf * dm_inv.transpose();
     [
         -(g.x_axis + g.y_axis + g.z_axis),
@@ -76,18 +90,25 @@ fn vertex_gradients(dcdf: Mat3, dm_inv: &Mat3) -> [Vec3; 4] {
 }
 
 #[inline]
-fn weighted_dot(w: &[f32; 4], a: &[Vec3; 4], b: &[Vec3; 4]) -> f32 {
+pub(super) fn weighted_dot(w: &[f32; 4], a: &[Vec3; 4], b: &[Vec3; 4]) -> f32 {
     w[0] * a[0].dot(b[0]) + w[1] * a[1].dot(b[1]) + w[2] * a[2].dot(b[2]) + w[3] * a[3].dot(b[3])
 }
 
-/// Project both constraints of one tet in place (`x` holds the nodes' displacements from
-/// rest, see [`deformation_gradient_from_displacement`]); returns the hydrostatic multiplier `λ_H`
-/// of this substep (used for the hydrostatic stress, PHYSICS.md §1.3).
+/// Project both constraints of `pair` of one tet in place (`x` holds the nodes'
+/// displacements from rest, see [`deformation_gradient_from_displacement`]); returns the
+/// volume multiplier of this substep (the seed's hydrostatic stress, PHYSICS.md §1.3).
 #[inline]
-pub fn project_tet(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms, mode: TetProjection) -> f32 {
-    match mode {
-        TetProjection::Coupled => project_coupled(x, w, t),
-        TetProjection::Sequential => project_sequential(x, w, t),
+pub fn project_tet(
+    x: &mut [Vec3; 4],
+    w: &[f32; 4],
+    t: &TetTerms,
+    mode: TetProjection,
+    pair: ConstraintPair,
+) -> f32 {
+    match (pair, mode) {
+        (ConstraintPair::RestFree, _) => super::rest_free::project_rest_free(x, w, t, mode),
+        (ConstraintPair::GammaShifted, TetProjection::Coupled) => project_coupled(x, w, t),
+        (ConstraintPair::GammaShifted, TetProjection::Sequential) => project_sequential(x, w, t),
     }
 }
 
@@ -143,7 +164,7 @@ fn project_sequential(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
 /// One scalar XPBD update: `Δλ = −C / (Σ w|∇C|² + α̃)`, `x_i += w_i ∇_i C Δλ`.
 // PHYSICS.md §1.2, XPBD update with λ = 0 at the start of the substep.
 #[inline]
-fn apply_scalar(x: &mut [Vec3; 4], w: &[f32; 4], g: &[Vec3; 4], c: f32, alpha: f32) -> f32 {
+pub(super) fn apply_scalar(x: &mut [Vec3; 4], w: &[f32; 4], g: &[Vec3; 4], c: f32, alpha: f32) -> f32 {
     let denom = weighted_dot(w, g, g) + alpha;
     if denom.is_nan() || denom <= 0.0 {
         return 0.0;
@@ -193,7 +214,13 @@ mod tests {
     fn coupled_projection_keeps_the_rest_state_of_a_tet() {
         // μ = λ: α̃_H = α̃_D, γ = 2. Displacements start at zero (the rest state).
         let mut u = [Vec3::ZERO; 4];
-        project_tet(&mut u, &[1.0; 4], &terms(0.5, 2.0), TetProjection::Coupled);
+        project_tet(
+            &mut u,
+            &[1.0; 4],
+            &terms(0.5, 2.0),
+            TetProjection::Coupled,
+            ConstraintPair::GammaShifted,
+        );
         for a in &u {
             assert!(a.length() < 1e-6, "a node moved by {a}");
         }
@@ -209,7 +236,9 @@ mod tests {
         ];
         let before: Vec3 = x.iter().sum();
         for mode in [TetProjection::Coupled, TetProjection::Sequential] {
-            project_tet(&mut x, &[2.0; 4], &terms(0.1, 1.5), mode);
+            for pair in [ConstraintPair::GammaShifted, ConstraintPair::RestFree] {
+                project_tet(&mut x, &[2.0; 4], &terms(0.1, 1.5), mode, pair);
+            }
             let after: Vec3 = x.iter().sum();
             assert!((after - before).length() < 1e-5);
         }
@@ -227,7 +256,13 @@ mod tests {
             gamma: 1.0,
         };
         for _ in 0..20 {
-            project_tet(&mut x, &[1.0; 4], &t, TetProjection::Coupled);
+            project_tet(
+                &mut x,
+                &[1.0; 4],
+                &t,
+                TetProjection::Coupled,
+                ConstraintPair::GammaShifted,
+            );
         }
         let det = deformation_gradient_from_displacement(&x, &Mat3::IDENTITY).determinant();
         assert!((det - 1.0).abs() < 1e-3, "det {det}");

@@ -3,9 +3,13 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::TetProjection;
+use super::{ConstraintPair, TetProjection};
 use crate::contact::{ContactError, CutZone};
-use crate::material::HydrostaticStiffness;
+use crate::material::{HydrostaticStiffness, Material};
+use crate::stress::StressMeasure;
+
+/// Default interval of the release check in simulation time, s (240 Hz).
+pub const DEFAULT_RELEASE_INTERVAL: f32 = 1.0 / 240.0;
 
 /// Settings of the XPBD small-steps solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -19,11 +23,21 @@ pub struct SolverParams {
     pub gravity: Vec3,
     /// Velocity damping rate, 1/s: `v ← v·max(0, 1 − damping·h)` each substep.
     pub damping: f32,
+    /// Which Neo-Hookean constraint pair: `RestFree` (default) or the seed's
+    /// `GammaShifted`.
+    pub constraints: ConstraintPair,
     /// How a tet's two constraints are projected.
     pub projection: TetProjection,
-    /// Stiffness of the hydrostatic constraint: `Lambda` (PHYSICS.md, default) or
-    /// `LambdaPlusMu` (small-strain response matches E and ν exactly).
+    /// Stiffness of the γ-shifted pair's hydrostatic constraint: `Lambda` (PHYSICS.md,
+    /// default) or `LambdaPlusMu` (small-strain response matches E and ν exactly). The
+    /// rest-free pair always matches E and ν.
     pub hydrostatic: HydrostaticStiffness,
+    /// The stress reported and compared with the threshold: `Cauchy` (default) or the
+    /// seed's `PaperEq3`.
+    pub stress: StressMeasure,
+    /// Simulation time between release checks, s (`None`: once per frame, as the seed).
+    /// A fixed interval makes tearing independent of the frame rate.
+    pub release_interval: Option<f32>,
     /// Worker threads for the coloured projection: 0 = all cores, 1 = serial.
     pub threads: usize,
     /// von Mises stress above which a tet is released, Pa; `None` disables cutting.
@@ -42,8 +56,11 @@ impl Default for SolverParams {
             substeps: 10,
             gravity: Vec3::new(0.0, 0.0, -9.81),
             damping: 1.0,
+            constraints: ConstraintPair::RestFree,
             projection: TetProjection::Coupled,
             hydrostatic: HydrostaticStiffness::Lambda,
+            stress: StressMeasure::Cauchy,
+            release_interval: Some(DEFAULT_RELEASE_INTERVAL),
             threads: 0,
             release_threshold: None,
             cut_zone: CutZone::Anywhere,
@@ -87,6 +104,14 @@ impl SolverParams {
                 );
             }
         }
+        if let Some(dt) = self.release_interval {
+            if !(dt.is_finite() && dt > 0.0) {
+                return bad(
+                    "release_interval",
+                    format!("must be a positive time in s, got {dt}"),
+                );
+            }
+        }
         if let CutZone::NearEdge { reach } = self.cut_zone {
             if !(reach.is_finite() && reach >= 0.0) {
                 return bad(
@@ -96,6 +121,38 @@ impl SolverParams {
             }
         }
         Ok(())
+    }
+
+    /// The Poisson ratios the constraint pair can represent (what a slider may offer).
+    pub fn poisson_range(&self) -> (f32, f32) {
+        match (self.constraints, self.hydrostatic) {
+            (ConstraintPair::GammaShifted, HydrostaticStiffness::Lambda) => (0.13, 0.499),
+            _ => (0.0, 0.499),
+        }
+    }
+
+    /// Check that the constraint pair can represent `material`: the rest-free pair needs
+    /// `0 ≤ ν < 0.5` (λ ≥ 0); the γ-shifted pair needs a positive volume stiffness
+    /// `λ_H − μ` at small strain (`ν > 1/8` with `hydrostatic: Lambda`) and λ_H > 0.
+    pub fn check_material(&self, material: &Material) -> Result<(), SolverError> {
+        let nu = material.poisson_ratio;
+        let msg = match (self.constraints, self.hydrostatic) {
+            (ConstraintPair::RestFree, _) if nu < 0.0 => format!(
+                "poisson_ratio {nu} is below 0: the rest-free Neo-Hookean pair needs 0 <= ν < 0.5 (λ >= 0)"
+            ),
+            (ConstraintPair::GammaShifted, HydrostaticStiffness::Lambda) if nu <= 0.125 => {
+                format!(
+                    "poisson_ratio {nu} is at or below 1/8: the γ-shifted pair with hydrostatic: Lambda then has no positive bulk stiffness (λ − μ + 2μ/3 <= 0) and the tissue collapses; use ν > 0.125, hydrostatic: LambdaPlusMu or constraints: RestFree"
+                )
+            }
+            (ConstraintPair::GammaShifted, HydrostaticStiffness::LambdaPlusMu) if nu < 0.0 => {
+                format!(
+                    "poisson_ratio {nu} is below 0: the γ-shifted pair needs 0 <= ν < 0.5"
+                )
+            }
+            _ => return Ok(()),
+        };
+        Err(SolverError::Unrepresentable { msg })
     }
 }
 
@@ -109,6 +166,12 @@ pub enum SolverError {
         /// Field name.
         field: &'static str,
         /// What is wrong.
+        msg: String,
+    },
+    /// The constraint pair cannot represent the material.
+    #[error("material: {msg}")]
+    Unrepresentable {
+        /// What is wrong and what would do.
         msg: String,
     },
     /// The material is unusable.

@@ -8,7 +8,10 @@ use glam::{Mat3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::coloring::greedy_tet_colors;
-use super::neo_hookean::{TetTerms, deformation_gradient_from_displacement, project_tet};
+use super::neo_hookean::{
+    ConstraintPair, TetTerms, deformation_gradient_from_displacement, project_tet,
+};
+use super::release_schedule::release_checks;
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
 use super::{FrameStats, SolverError, SolverParams};
@@ -17,7 +20,8 @@ use crate::cutting::{CutState, ReleaseEvent};
 use crate::grab::Grab;
 use crate::material::{Lame, Material};
 use crate::mesh::TetMesh;
-use crate::stress::tet_stress;
+use crate::stress::{StressMeasure, cauchy_stress, tet_stress, von_mises};
+use crate::xpbd::{Strain, displacement_gradient};
 
 /// Tets per rayon task: large enough to amortise scheduling, small enough to balance.
 const CHUNK: usize = 256;
@@ -71,10 +75,15 @@ pub struct Solver {
     pub(crate) det_f: Vec<f32>,
     pub(crate) inverted_frames: Vec<u32>,
     pub(crate) cut: CutState,
+    /// Tets switched off by a release check during the frame in hand (mesh indices); the
+    /// cut state takes them when the frame has passed its guards.
+    pub(crate) pending: Vec<u32>,
     /// The tool, if one is attached, and its motion over the coming frame.
     pub(crate) tool: Option<ToolMotion>,
     /// Nodes that came within the cut reach of a cutting sphere this frame.
     pub(crate) near_edge: Vec<bool>,
+    /// The same since the last release check (what a `NearEdge` cut zone releases by).
+    pub(crate) near_window: Vec<bool>,
     /// Per node, Σ m Δx of the contact projections this frame (tissue side), kg·m.
     pub(crate) contact_push: Vec<Vec3>,
     pub(crate) frame: u64,
@@ -91,6 +100,7 @@ impl Solver {
     ) -> Result<Self, SolverError> {
         material.validate()?;
         params.validate()?;
+        params.check_material(&material)?;
         let lame = material.lame();
         let (colors, ncolors) = greedy_tet_colors(mesh.node_count(), &mesh.tets);
         let mut order: Vec<u32> = (0..mesh.tet_count() as u32).collect();
@@ -116,7 +126,7 @@ impl Solver {
             .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
             .collect();
         let (kappa, tet) = stiffness_number(&mesh, &inv_mass, lame, params.substep());
-        if kappa > MAX_STIFFNESS_NUMBER {
+        if params.constraints == ConstraintPair::GammaShifted && kappa > MAX_STIFFNESS_NUMBER {
             return Err(SolverError::Unstable {
                 h_ms: params.substep() * 1e3,
                 tet,
@@ -159,8 +169,10 @@ impl Solver {
             det_f: vec![1.0; t],
             inverted_frames: vec![0; t],
             cut: CutState::new(&mesh),
+            pending: Vec::new(),
             tool: None,
             near_edge: vec![false; n],
+            near_window: vec![false; n],
             contact_push: vec![Vec3::ZERO; n],
             frame: 0,
             time: 0.0,
@@ -192,11 +204,20 @@ impl Solver {
         let v = self.mesh.rest_volume[t];
         TetTerms {
             dm_inv: self.mesh.dm_inv[t],
-            // PHYSICS.md §1.2: α_H = 1/(λ_H V), α_D = 1/(μV), α̃ = α/h² (λ_H: see
-            // `Lame::hydrostatic`).
-            alpha_h: 1.0 / (self.lame.hydrostatic(self.params.hydrostatic) * v * h * h),
+            // PHYSICS.md §1.2: α_H = 1/(λ_H V), α_D = 1/(μV), α̃ = α/h². λ_H is λ for the
+            // rest-free pair (infinite compliance at ν = 0: no volume constraint), see
+            // `Lame::hydrostatic` for the γ-shifted one.
+            alpha_h: 1.0 / (self.volume_stiffness() * v * h * h),
             alpha_d: 1.0 / (self.lame.mu * v * h * h),
             gamma: self.lame.gamma(self.params.hydrostatic),
+        }
+    }
+
+    /// Stiffness of the volume constraint, Pa: λ (rest-free) or λ_H (γ-shifted).
+    pub fn volume_stiffness(&self) -> f32 {
+        match self.params.constraints {
+            ConstraintPair::RestFree => self.lame.lambda,
+            ConstraintPair::GammaShifted => self.lame.hydrostatic(self.params.hydrostatic),
         }
     }
 
@@ -354,42 +375,37 @@ impl Solver {
         ev
     }
 
-    /// Advance one frame: `substeps` XPBD substeps, then stress, guards and release.
+    /// Advance one frame: `substeps` XPBD substeps with the release checks that fall in
+    /// them, then stress, guards, and the frame's releases handed to the cut state.
     ///
     /// On a NaN/Inf position or a tet inverted for longer than `max_inverted_frames`, the
-    /// frame is rolled back and an error names the frame and the tet.
+    /// frame is rolled back (tets switched off during it come back) and an error names the
+    /// frame and the tet.
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
         let saved = (self.u.clone(), self.v.clone());
         let t0 = Instant::now();
         self.near_edge.iter_mut().for_each(|b| *b = false);
         self.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
-        match self.pool.take() {
-            Some(pool) => {
-                pool.install(|| self.run_substeps(true));
-                self.pool = Some(pool);
-            }
-            None => self.run_substeps(false),
-        }
+        let fresh = self.with_pool(|s, parallel| s.run_substeps(parallel));
         self.time += self.params.frame_dt as f64;
         self.sync_positions();
         let t1 = Instant::now();
-        let checked = match self.pool.take() {
-            Some(pool) => {
-                let r = pool.install(|| self.update_stress_and_check(true));
-                self.pool = Some(pool);
-                r
-            }
-            None => self.update_stress_and_check(false),
-        };
+        let checked = self.with_pool(|s, parallel| s.update_stress_and_check(parallel, fresh));
         if let Err(e) = checked {
             self.u = saved.0;
             self.u_prev.clone_from(&self.u);
             self.v = saved.1;
             self.sync_positions();
             self.time -= self.params.frame_dt as f64;
+            self.revive_pending();
             return Err(e);
         }
-        let released = self.release_overstressed();
+        let pending = std::mem::take(&mut self.pending);
+        let released = if pending.is_empty() {
+            0
+        } else {
+            self.release(&pending).tets.len()
+        };
         if let Some(m) = &mut self.tool {
             m.from = m.to;
         }
@@ -400,9 +416,38 @@ impl Solver {
         Ok(stats)
     }
 
-    fn run_substeps(&mut self, parallel: bool) {
+    /// Run `f` inside the solver's thread pool (parallel) or on this thread.
+    fn with_pool<R>(&mut self, f: impl FnOnce(&mut Self, bool) -> R + Send) -> R
+    where
+        R: Send,
+    {
+        match self.pool.take() {
+            Some(pool) => {
+                let r = pool.install(|| f(self, true));
+                self.pool = Some(pool);
+                r
+            }
+            None => f(self, false),
+        }
+    }
+
+    /// Switch the tets of a rolled-back frame's release checks back on.
+    fn revive_pending(&mut self) {
+        for t in std::mem::take(&mut self.pending) {
+            self.slots[self.slot_of_tet[t as usize] as usize].live = true;
+        }
+    }
+
+    /// The frame's substeps; after each substep in which a release check falls, stress
+    /// and release (PHYSICS.md §1.4 on a fixed simulation-time interval). Returns whether
+    /// the stress is current for the end of the frame (a check ran after the last
+    /// substep).
+    fn run_substeps(&mut self, parallel: bool) -> bool {
         let h = self.params.substep();
         let n = self.params.substeps;
+        let checks = release_checks(self.time, h, n, self.params.release_interval);
+        let mut next = checks.iter().peekable();
+        let mut fresh = false;
         for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
@@ -411,7 +456,14 @@ impl Solver {
             }
             self.project_contacts(s, n);
             self.update_velocities(h);
+            fresh = false;
+            if next.next_if(|&&k| k == s).is_some() {
+                self.compute_stress(parallel);
+                self.switch_off_overstressed();
+                fresh = true;
+            }
         }
+        fresh
     }
 
     /// Push free nodes out of the tool as it moves through substep `s` of `n`
@@ -443,6 +495,7 @@ impl Solver {
                 self.contact_push[i] += self.mass[i] * (c.x - x);
             }
             self.near_edge[i] |= c.near_edge;
+            self.near_window[i] |= c.near_edge;
         }
     }
 
@@ -469,6 +522,7 @@ impl Solver {
     fn project_color(&mut self, c: usize, parallel: bool) {
         let range = self.color_ranges[c].clone();
         let mode = self.params.projection;
+        let pair = self.params.constraints;
         let nodes = SharedNodes::new(&mut self.u);
         let inv_mass = &self.inv_mass;
         let work = |slot: &TetSlot, lambda: &mut f32| {
@@ -480,7 +534,7 @@ impl Solver {
             // this task only during the pass.
             let mut p = idx.map(|i| unsafe { nodes.get(i) });
             let w = idx.map(|i| inv_mass[i as usize]);
-            *lambda = project_tet(&mut p, &w, &slot.terms, mode);
+            *lambda = project_tet(&mut p, &w, &slot.terms, mode, pair);
             for k in 0..4 {
                 // SAFETY: as above.
                 unsafe { nodes.set(idx[k], p[k]) };
@@ -516,10 +570,13 @@ impl Solver {
         }
     }
 
-    /// Stress and det F per live tet, then the NaN and inversion guards.
-    fn update_stress_and_check(&mut self, parallel: bool) -> Result<(), SolverError> {
+    /// Stress and det F per live tet (unless `fresh` from a check after the last
+    /// substep), then the NaN and inversion guards.
+    fn update_stress_and_check(&mut self, parallel: bool, fresh: bool) -> Result<(), SolverError> {
         self.check_finite()?;
-        self.compute_stress(parallel);
+        if !fresh {
+            self.compute_stress(parallel);
+        }
         self.check_inversion()
     }
 
@@ -548,26 +605,21 @@ impl Solver {
         Ok(())
     }
 
-    /// σ_vM, det F and the polar rotation of every live tet (PHYSICS.md §1.3).
+    /// σ_vM and det F of every live tet (and, for the seed's eq. 3, the polar rotation).
     fn compute_stress(&mut self, parallel: bool) {
-        let h = self.params.substep();
-        let mu = self.lame.mu;
-        let (mesh, u, cut) = (&self.mesh, &self.u, &self.cut);
-        let (lambda_h, slot_of_tet) = (&self.lambda_h, &self.slot_of_tet);
-        let compute = |t: usize, out: (&mut f32, &mut f32, &mut Quat)| {
-            if !cut.is_live(t) {
-                *out.0 = 0.0;
-                return;
-            }
-            let idx = mesh.tets[t];
-            let d = idx.map(|i| u[i as usize]);
-            let f: Mat3 = deformation_gradient_from_displacement(&d, &mesh.dm_inv[t]);
-            let lam = lambda_h[slot_of_tet[t] as usize];
-            let s = tet_stress(&f, mu, lam, h * h, mesh.rest_volume[t], *out.2);
-            *out.0 = s.von_mises;
-            *out.1 = f.determinant();
-            *out.2 = s.rotation;
+        let eval = TetStressEval {
+            mesh: &self.mesh,
+            u: &self.u,
+            slots: &self.slots,
+            slot_of_tet: &self.slot_of_tet,
+            lambda_h: &self.lambda_h,
+            lame: self.lame,
+            volume_stiffness: self.volume_stiffness(),
+            pair: self.params.constraints,
+            measure: self.params.stress,
+            h2: self.params.substep() * self.params.substep(),
         };
+        let compute = |t: usize, out: (&mut f32, &mut f32, &mut Quat)| eval.tet(t, out);
         if parallel {
             self.von_mises
                 .par_iter_mut()
@@ -615,26 +667,30 @@ impl Solver {
         Ok(())
     }
 
-    /// Release live tets whose von Mises stress exceeds the threshold (PHYSICS.md §1.4, eq. 5).
-    fn release_overstressed(&mut self) -> usize {
+    /// Switch off live tets whose von Mises stress exceeds the threshold (PHYSICS.md §1.4,
+    /// eq. 5); with a `NearEdge` cut zone only those a cutting sphere came near since the
+    /// last check. They join the frame's pending releases; the near-edge window restarts.
+    fn switch_off_overstressed(&mut self) {
         let Some(threshold) = self.params.release_threshold else {
-            return 0;
+            return;
         };
         let near_edge = matches!(self.params.cut_zone, CutZone::NearEdge { .. });
         let over: Vec<u32> = (0..self.von_mises.len())
-            .filter(|&t| self.cut.is_live(t) && self.von_mises[t] > threshold)
+            .filter(|&t| self.slots[self.slot_of_tet[t] as usize].live)
+            .filter(|&t| self.von_mises[t] > threshold)
             .filter(|&t| {
                 !near_edge
                     || self.mesh.tets[t]
                         .iter()
-                        .any(|&i| self.near_edge[i as usize])
+                        .any(|&i| self.near_window[i as usize])
             })
             .map(|t| t as u32)
             .collect();
-        if over.is_empty() {
-            return 0;
+        for &t in &over {
+            self.slots[self.slot_of_tet[t as usize] as usize].live = false;
         }
-        self.release(&over).tets.len()
+        self.pending.extend(over);
+        self.near_window.iter_mut().for_each(|b| *b = false);
     }
 
     /// Mean force the tissue exerted on the tool over the last frame, N: the contact
@@ -692,6 +748,49 @@ impl Solver {
                 .count(),
             solve_ms: 0.0,
             stress_ms: 0.0,
+        }
+    }
+}
+
+/// What the per-tet stress reads (shared by the parallel stress pass).
+struct TetStressEval<'a> {
+    mesh: &'a TetMesh,
+    u: &'a [Vec3],
+    slots: &'a [TetSlot],
+    slot_of_tet: &'a [u32],
+    lambda_h: &'a [f32],
+    lame: Lame,
+    volume_stiffness: f32,
+    pair: ConstraintPair,
+    measure: StressMeasure,
+    h2: f32,
+}
+
+impl TetStressEval<'_> {
+    /// σ_vM, det F and rotation of tet `t` (zero stress when switched off).
+    fn tet(&self, t: usize, out: (&mut f32, &mut f32, &mut Quat)) {
+        let slot = self.slot_of_tet[t] as usize;
+        if !self.slots[slot].live {
+            *out.0 = 0.0;
+            return;
+        }
+        let d = self.mesh.tets[t].map(|i| self.u[i as usize]);
+        let dm_inv = &self.mesh.dm_inv[t];
+        match self.measure {
+            StressMeasure::Cauchy => {
+                let s = Strain::of(displacement_gradient(&d, dm_inv));
+                let sigma = cauchy_stress(&s, self.lame, self.pair, self.volume_stiffness);
+                *out.0 = von_mises(&sigma);
+                *out.1 = s.j();
+            }
+            StressMeasure::PaperEq3 => {
+                let f: Mat3 = deformation_gradient_from_displacement(&d, dm_inv);
+                let lam = self.lambda_h[slot];
+                let st = tet_stress(&f, self.lame.mu, lam, self.h2, self.mesh.rest_volume[t], *out.2);
+                *out.0 = st.von_mises;
+                *out.1 = f.determinant();
+                *out.2 = st.rotation;
+            }
         }
     }
 }
