@@ -141,6 +141,9 @@ impl Cantilever {
             // Critical for the first mode; damping does not move the static equilibrium.
             damping: 2.0 * self.first_mode(),
             threads: 1,
+            // The seed's pair, on which these Euler–Bernoulli comparisons were calibrated
+            // (docs/physics-notes.md: its λ_H = λ softness cancels bending locking).
+            constraints: incise_sim::xpbd::ConstraintPair::GammaShifted,
             ..SolverParams::default()
         }
     }

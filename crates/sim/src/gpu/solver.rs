@@ -191,7 +191,12 @@ impl GpuSolver {
                 let v = host.mesh.rest_volume[host.tet_of_slot[i] as usize];
                 TetRest {
                     // No volume constraint (λ = 0, infinite compliance): −1 on the device.
-                    c0: [m.x_axis.x, m.x_axis.y, m.x_axis.z, finite_or_none(s.terms.alpha_h)],
+                    c0: [
+                        m.x_axis.x,
+                        m.x_axis.y,
+                        m.x_axis.z,
+                        finite_or_none(s.terms.alpha_h),
+                    ],
                     c1: [m.y_axis.x, m.y_axis.y, m.y_axis.z, s.terms.alpha_d],
                     c2: [m.z_axis.x, m.z_axis.y, m.z_axis.z, v],
                 }
@@ -711,8 +716,6 @@ impl GpuSolver {
         pass.set_bind_group(0, &self.bind.clear_window, &[]);
         pass.dispatch_workgroups(groups(self.host.x.len()), 1, 1);
     }
-
-
 
     /// Map the staging buffers, copy into the host mirror; returns released slots.
     fn read_back(&mut self) -> Result<Vec<u32>, GpuError> {

@@ -145,14 +145,20 @@ mod tests {
         for pair in [ConstraintPair::RestFree, ConstraintPair::GammaShifted] {
             let l = lame(0.45);
             let lh = l.lambda + l.mu;
-            assert_eq!(cauchy_stress(&strain(Mat3::IDENTITY), l, pair, lh), Mat3::ZERO);
+            assert_eq!(
+                cauchy_stress(&strain(Mat3::IDENTITY), l, pair, lh),
+                Mat3::ZERO
+            );
             // Linear elasticity at ε = 1e-6 shear: σ_xy = 2 μ ε.
             let mut h = Mat3::ZERO;
             h.y_axis.x = 1e-6;
             h.x_axis.y = 1e-6;
             let sigma = cauchy_stress(&Strain::of(h), l, pair, lh);
             let expect = 2.0 * l.mu * 1e-6;
-            assert!(((sigma.y_axis.x - expect) / expect).abs() < 1e-4, "{pair:?}");
+            assert!(
+                ((sigma.y_axis.x - expect) / expect).abs() < 1e-4,
+                "{pair:?}"
+            );
         }
     }
 

@@ -2,6 +2,7 @@
 //! polar decomposition; von Mises (PHYSICS.md §1.3).
 
 mod cauchy;
+pub mod closed_form;
 mod polar;
 mod von_mises;
 

@@ -16,9 +16,9 @@ pub use frame::FrameStats;
 pub use neo_hookean::{
     ConstraintPair, TetProjection, TetTerms, deformation_gradient, det_gradient, project_tet,
 };
+pub use params::{DEFAULT_RELEASE_INTERVAL, SolverError, SolverParams};
 pub use release_schedule::release_checks;
 pub use rest_free::{J_MIN, log_volume, shape_constraint, shape_energy, volume_constraint};
-pub use strain::{Strain, cofactor, displacement_gradient, log1p_excess};
-pub use params::{DEFAULT_RELEASE_INTERVAL, SolverError, SolverParams};
 pub use solver::{NodeKind, Solver};
 pub use stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
+pub use strain::{Strain, cofactor, displacement_gradient, log1p_excess};

@@ -164,7 +164,13 @@ fn project_sequential(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
 /// One scalar XPBD update: `Δλ = −C / (Σ w|∇C|² + α̃)`, `x_i += w_i ∇_i C Δλ`.
 // PHYSICS.md §1.2, XPBD update with λ = 0 at the start of the substep.
 #[inline]
-pub(super) fn apply_scalar(x: &mut [Vec3; 4], w: &[f32; 4], g: &[Vec3; 4], c: f32, alpha: f32) -> f32 {
+pub(super) fn apply_scalar(
+    x: &mut [Vec3; 4],
+    w: &[f32; 4],
+    g: &[Vec3; 4],
+    c: f32,
+    alpha: f32,
+) -> f32 {
     let denom = weighted_dot(w, g, g) + alpha;
     if denom.is_nan() || denom <= 0.0 {
         return 0.0;

@@ -146,9 +146,7 @@ impl SolverParams {
                 )
             }
             (ConstraintPair::GammaShifted, HydrostaticStiffness::LambdaPlusMu) if nu < 0.0 => {
-                format!(
-                    "poisson_ratio {nu} is below 0: the γ-shifted pair needs 0 <= ν < 0.5"
-                )
+                format!("poisson_ratio {nu} is below 0: the γ-shifted pair needs 0 <= ν < 0.5")
             }
             _ => return Ok(()),
         };

@@ -75,7 +75,12 @@ pub fn shape_constraint(s: &Strain) -> Option<(f32, Mat3)> {
 /// Project both rest-free constraints of one tet in place (`x` holds displacements);
 /// returns the volume multiplier of this substep.
 #[inline]
-pub fn project_rest_free(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms, mode: TetProjection) -> f32 {
+pub fn project_rest_free(
+    x: &mut [Vec3; 4],
+    w: &[f32; 4],
+    t: &TetTerms,
+    mode: TetProjection,
+) -> f32 {
     match mode {
         TetProjection::Coupled => project_coupled(x, w, t),
         TetProjection::Sequential => project_sequential(x, w, t),
@@ -201,7 +206,10 @@ mod tests {
         for j in [0.05f32, 0.0, -0.5] {
             let f = Mat3::from_diagonal(Vec3::new(j, 1.0, 1.0));
             let (psi, g) = shape_energy(&strain(f));
-            assert!(psi > 0.0 && psi.is_finite() && g.is_finite(), "J = {j}: {psi}");
+            assert!(
+                psi > 0.0 && psi.is_finite() && g.is_finite(),
+                "J = {j}: {psi}"
+            );
             let (c, dc) = volume_constraint(&strain(f));
             assert!(c.is_finite() && dc.is_finite());
         }

@@ -126,7 +126,7 @@ impl Solver {
             .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
             .collect();
         let (kappa, tet) = stiffness_number(&mesh, &inv_mass, lame, params.substep());
-        if params.constraints == ConstraintPair::GammaShifted && kappa > MAX_STIFFNESS_NUMBER {
+        if kappa > MAX_STIFFNESS_NUMBER {
             return Err(SolverError::Unstable {
                 h_ms: params.substep() * 1e3,
                 tet,
@@ -786,7 +786,14 @@ impl TetStressEval<'_> {
             StressMeasure::PaperEq3 => {
                 let f: Mat3 = deformation_gradient_from_displacement(&d, dm_inv);
                 let lam = self.lambda_h[slot];
-                let st = tet_stress(&f, self.lame.mu, lam, self.h2, self.mesh.rest_volume[t], *out.2);
+                let st = tet_stress(
+                    &f,
+                    self.lame.mu,
+                    lam,
+                    self.h2,
+                    self.mesh.rest_volume[t],
+                    *out.2,
+                );
                 *out.0 = st.von_mises;
                 *out.1 = f.determinant();
                 *out.2 = st.rotation;

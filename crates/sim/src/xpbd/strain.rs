@@ -75,7 +75,9 @@ impl Strain {
     /// `‖H‖²_F`.
     #[inline]
     pub fn h_norm2(&self) -> f32 {
-        self.h.x_axis.length_squared() + self.h.y_axis.length_squared() + self.h.z_axis.length_squared()
+        self.h.x_axis.length_squared()
+            + self.h.y_axis.length_squared()
+            + self.h.z_axis.length_squared()
     }
 
     /// `cof F = (1 + tr H) I − Hᵀ + cof H` (the 3×3 identity for `cof(I + H)`).
@@ -131,7 +133,9 @@ mod tests {
         assert!((s.cof_f() - cof).abs_diff_eq(Mat3::ZERO, 1e-6));
         let direct = f * f.determinant() - cof;
         assert!((s.j_f_minus_cof() - direct).abs_diff_eq(Mat3::ZERO, 1e-6));
-        assert!((s.b_minus_i() - (f * f.transpose() - Mat3::IDENTITY)).abs_diff_eq(Mat3::ZERO, 1e-6));
+        assert!(
+            (s.b_minus_i() - (f * f.transpose() - Mat3::IDENTITY)).abs_diff_eq(Mat3::ZERO, 1e-6)
+        );
     }
 
     /// At strains of 1e-7 the direct forms are noise in f32; the H forms keep their
@@ -143,14 +147,19 @@ mod tests {
         let tr = h.x_axis.x + h.y_axis.y + h.z_axis.z;
         assert!(((s.j1 - tr) / tr).abs() < 1e-5, "{} vs {tr}", s.j1);
         let direct = (Mat3::IDENTITY + h).determinant() - 1.0;
-        assert!(((direct - tr) / tr).abs() > 1e-3, "f32 det F − 1 unexpectedly exact");
+        assert!(
+            ((direct - tr) / tr).abs() > 1e-3,
+            "f32 det F − 1 unexpectedly exact"
+        );
     }
 
     #[test]
     fn log1p_excess_matches_f64() {
         // The series to 1e-6 relative; the direct form just past it loses ~1e-5 to the
         // rounding of 1 + x (harmless: it is a term of C_D², of order strain²).
-        for x in [-0.6f32, -0.2, -0.099, -1e-3, 0.0, 2e-4, 0.0999, 0.1, 0.3, 2.0] {
+        for x in [
+            -0.6f32, -0.2, -0.099, -1e-3, 0.0, 2e-4, 0.0999, 0.1, 0.3, 2.0,
+        ] {
             let exact = x as f64 - (x as f64).ln_1p();
             let got = log1p_excess(x) as f64;
             let rel = if x.abs() < SERIES_LIMIT { 1e-6 } else { 3e-5 };
