@@ -31,7 +31,7 @@ const BAR: &str = r#"(
     pins: [PlaneSide(point: (0.001, 0, 0), normal: (-1, 0, 0))],
     grabs: [(nodes: PlaneSide(point: (0.079, 0, 0), normal: (1, 0, 0)), path: [(0.06, 0, 0)], speed: 0.1)],
     solver: (substeps: 30, gravity: (0, 0, 0)),
-    cutting: Some((von_mises_threshold: 6e3)),
+    cutting: Some((von_mises_threshold: 12e3)),
     duration: 0.2,
 )"#;
 
