@@ -1,7 +1,8 @@
 //! The XR frame loop, the same for the OpenXR session and the simulated headset: per
-//! display frame, controller input → tray and scalpel, the pacer's simulation frames
-//! (fixed dt, substeps cut before time when late), vibration from the contact force, both
-//! eyes rendered into the headset's targets, and a frame-time row.
+//! display frame, controller input → tray and scalpel (or a recorded stroke in simulation
+//! time), the pacer's simulation frames (fixed dt, substeps cut before time when late),
+//! vibration from the contact force, both eyes rendered into the headset's targets, and a
+//! frame-time row.
 
 use std::time::Instant;
 
@@ -12,8 +13,8 @@ use incise_sim::skin::Skin;
 use incise_xr::frame::{ToolState, pinned_nodes};
 use incise_xr::openxr::controls::{ControllerState, commands};
 use incise_xr::openxr::eye::eye_view;
-use incise_xr::openxr::haptics::haptic_pulse;
-use incise_xr::openxr::lifecycle::ExitReason;
+use incise_xr::openxr::haptics::{HapticCall, HapticGate, haptic_pulse};
+use incise_xr::openxr::lifecycle::{ExitReason, SessionPhase};
 use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
 use incise_xr::openxr::tray::Tray;
@@ -50,6 +51,9 @@ pub struct LoopOptions<'a> {
     /// Testing aid: a NaN in the solver just before this simulation frame of the session
     /// (the frame fails, is rolled back and the scene reset).
     pub inject_nan_at: Option<u64>,
+    /// Drive the scalpel along this stroke (sim world, simulation time), engaged, instead
+    /// of the right controller; the session ends when the stroke has been played.
+    pub stroke: Option<&'a Stroke>,
 }
 
 /// What a session did.
@@ -62,6 +66,9 @@ pub struct LoopOutcome {
     pub sim_frames: u64,
     /// Released tets at the end.
     pub released_tets: usize,
+    /// Bounding box (min, max corners, sim world, m) of the released tets' rest
+    /// centroids: where the cut is.
+    pub cut_box: Option<([f32; 3], [f32; 3])>,
     /// Largest tool contact force, N.
     pub max_tool_force: f32,
     /// Largest vibration amplitude sent.
@@ -74,6 +81,15 @@ pub struct LoopOutcome {
     pub solver_resets: u32,
     /// How the session ended (`None`: the runtime never made it ready).
     pub exit: Option<ExitReason>,
+    /// Whether Ctrl-C (or SIGTERM) ended it.
+    pub interrupted: bool,
+    /// Vibration pulses sent (`xrApplyHapticFeedback`).
+    pub haptic_pulses: u64,
+    /// Vibration stops sent (`xrStopHapticFeedback`): one each time the blade left the
+    /// tissue, and one at the end if it was still vibrating.
+    pub haptic_stops: u64,
+    /// The session states, in order.
+    pub session_states: Vec<SessionPhase>,
     /// The scalpel's path, when recorded and the controller was tracked.
     pub stroke: Option<Stroke>,
     /// Per-frame times.
@@ -122,12 +138,17 @@ pub fn run_loop(
         rendered: 0,
         sim_frames: 0,
         released_tets: 0,
+        cut_box: None,
         max_tool_force: 0.0,
         max_haptic: 0.0,
         dropped_time: 0.0,
         min_substeps_used: nominal,
         solver_resets: 0,
         exit: None,
+        interrupted: false,
+        haptic_pulses: 0,
+        haptic_stops: 0,
+        session_states: Vec::new(),
         stroke: None,
         log: FrameLog::default(),
         error: None,
@@ -136,11 +157,16 @@ pub fn run_loop(
     let mut idle = 0;
     let mut exit_asked = false;
     let mut inject_nan_at = opts.inject_nan_at;
+    let mut haptics = HapticGate::default();
     // Every frame runs inside this closure so that a failure mid-frame still ends with
     // the stroke, the frame log and the report saved.
     let mut session = || -> Result<()> {
         if let Some(ex) = exercise.as_deref_mut() {
             ex.start(xr, skin, &dev)?;
+        }
+        if let Some(s) = opts.stroke {
+            // The blade starts where the stroke does (as `incise run --stroke` places it).
+            xr.drive_tool(Some(s.pose_at(0.0)), true)?;
         }
         loop {
             let frame = match headset.next_frame()? {
@@ -149,6 +175,13 @@ pub fn run_loop(
                     break;
                 }
                 FrameEvent::Idle => {
+                    // Ctrl-C before the runtime runs the session (or between runs): the
+                    // lifecycle ends a session that is not running at once.
+                    if !exit_asked && crate::interrupt::requested() {
+                        exit_asked = true;
+                        out.interrupted = true;
+                        headset.request_exit()?;
+                    }
                     idle += 1;
                     if idle > MAX_IDLE {
                         break;
@@ -179,7 +212,7 @@ pub fn run_loop(
                 tray = tray.placed_at(grip);
             }
             tray = tray.steered(c.stick, frame.display_period as f32);
-            let engaged = c.blade_engaged();
+            let engaged = opts.stroke.is_some() || c.blade_engaged();
             let tool_pose = c.right_grip.map(|g| scalpel_pose(g, opts.blade, &tray));
 
             // Simulation: the pacer's frames at the fixed dt, never waiting for the display.
@@ -194,6 +227,12 @@ pub fn run_loop(
             let mut force = 0.0f32;
             let mut stepped = 0u64;
             for _ in 0..plan.sim_frames {
+                // A stroke is played in simulation time: the pose at the end of this frame,
+                // as `incise run --stroke` moves it.
+                let tool_pose = match opts.stroke {
+                    Some(s) => Some(s.pose_at(sim_time + sim_dt)),
+                    None => tool_pose,
+                };
                 xr.drive_tool(tool_pose, engaged)?;
                 if inject_nan_at == Some(out.sim_frames + stepped) {
                     inject_nan_at = None;
@@ -235,7 +274,17 @@ pub fn run_loop(
 
             let amplitude = (opts.haptic)(force);
             let pulse = haptic_pulse(amplitude, engaged, frame.display_period);
-            headset.vibrate(pulse)?;
+            match haptics.next(pulse) {
+                HapticCall::Apply(p) => {
+                    headset.vibrate(Some(p))?;
+                    out.haptic_pulses += 1;
+                }
+                HapticCall::Stop => {
+                    headset.vibrate(None)?;
+                    out.haptic_stops += 1;
+                }
+                HapticCall::Nothing => {}
+            }
             let sent = pulse.map_or(0.0, |p| p.amplitude);
             out.max_haptic = out.max_haptic.max(sent);
 
@@ -307,12 +356,15 @@ pub fn run_loop(
             });
             out.frames += 1;
             // Ctrl-C ends the session the way the runtime expects (xrRequestExitSession),
-            // so the stroke and report are saved as after any other end.
+            // so the stroke and report are saved as after any other end; so do the frame
+            // limit and the end of a played stroke.
+            let interrupted = crate::interrupt::requested();
+            let stroke_done = opts.stroke.is_some_and(|s| sim_time >= s.end_time());
             if !exit_asked
-                && (opts.max_frames.is_some_and(|m| out.frames >= m)
-                    || crate::interrupt::requested())
+                && (interrupted || stroke_done || opts.max_frames.is_some_and(|m| out.frames >= m))
             {
                 exit_asked = true;
+                out.interrupted = interrupted;
                 headset.request_exit()?;
             }
         }
@@ -345,11 +397,31 @@ pub fn run_loop(
         }
     }
     // The controller may be gone with the session: stopping its vibration can fail.
-    let _ = headset.vibrate(None);
+    if haptics.vibrating() {
+        let _ = headset.vibrate(None);
+        out.haptic_stops += 1;
+    }
+    out.session_states = headset.session_states().to_vec();
     out.dropped_time = pacer.dropped_time();
-    out.released_tets = (0..xr.solver().mesh().tet_count())
+    let mesh = xr.solver().mesh();
+    let released: Vec<glam::Vec3> = (0..mesh.tet_count())
         .filter(|&i| !xr.solver().cut().is_live(i))
-        .count();
+        .map(|i| {
+            mesh.tets[i]
+                .iter()
+                .map(|&n| mesh.rest_positions[n as usize])
+                .sum::<glam::Vec3>()
+                * 0.25
+        })
+        .collect();
+    out.released_tets = released.len();
+    out.cut_box = released
+        .iter()
+        .fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, &c| {
+            let (lo, hi) = b.unwrap_or((c, c));
+            Some((lo.min(c), hi.max(c)))
+        })
+        .map(|(lo, hi)| (lo.to_array(), hi.to_array()));
     if opts.record && !recorder.is_empty() {
         out.stroke = Some(recorder.finish()?);
     }
