@@ -88,6 +88,38 @@ fn a_session_on_monado_runs_from_idle_to_exiting_and_renders_every_frame_it_may(
     assert_eq!(r["haptic_stops"].as_u64(), Some(0), "{r}");
     let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
     assert_eq!(csv.lines().count(), 31);
+    // Display frames the runtime skipped while incise was late, counted from the
+    // predicted display times at its nominal period (Monado's pacing also stretches the
+    // period of a slow app; with the solver inside the frame loop most frames are late).
+    assert!(r["display_hz"].as_f64().unwrap() > 1.0, "{r}");
+    let rows: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (c[1].parse().unwrap(), c[11].parse().unwrap())
+        })
+        .collect();
+    let nominal = rows.iter().map(|r| r.1).fold(f64::INFINITY, f64::min);
+    assert!(
+        (r["display_hz"].as_f64().unwrap() - 1.0 / nominal).abs() < 1e-3,
+        "{r}"
+    );
+    let skipped: u64 = rows
+        .windows(2)
+        .map(|w| (((w[1].0 - w[0].0) / nominal).round() as u64).saturating_sub(1))
+        .sum();
+    // (The CSV's microsecond times can round a gap across a half period.)
+    let dropped = r["dropped_frames"].as_u64().unwrap();
+    assert!(
+        dropped.abs_diff(skipped) <= 1 + skipped / 50,
+        "{dropped} dropped, {skipped} from frames.csv: {r}"
+    );
+    assert!(
+        dropped > 0,
+        "the solver inside the frame loop is late on lavapipe: {r}"
+    );
+    assert!(r["sim_steps_per_s"].as_f64().unwrap() > 0.0, "{r}");
     // The fixed grip pose was recorded, and loads as a stroke.
     let stroke = incise_scalpel::load_stroke(&out.join("stroke.ron")).unwrap();
     assert!(stroke.keys().len() > 1);

@@ -31,6 +31,8 @@ pub struct FrameRow {
     pub tool_force: f32,
     /// Vibration amplitude sent, 0..1.
     pub haptic: f32,
+    /// The runtime's predicted display period for this frame, s.
+    pub display_period: f64,
 }
 
 /// The rows of a session.
@@ -44,12 +46,12 @@ impl FrameLog {
     /// The log as CSV with a header line.
     pub fn to_csv(&self) -> String {
         let mut s = String::from(
-            "frame,display_time_s,sim_frames,substeps,sim_ms,render_ms,frame_ms,rendered,engaged,tool_force_n,haptic\n",
+            "frame,display_time_s,sim_frames,substeps,sim_ms,render_ms,frame_ms,rendered,engaged,tool_force_n,haptic,display_period_s\n",
         );
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{},{:.6},{},{},{:.3},{:.3},{:.3},{},{},{:.4},{:.3}",
+                "{},{:.6},{},{},{:.3},{:.3},{:.3},{},{},{:.4},{:.3},{:.6}",
                 r.frame,
                 r.display_time,
                 r.sim_frames,
@@ -60,7 +62,8 @@ impl FrameLog {
                 u8::from(r.rendered),
                 u8::from(r.engaged),
                 r.tool_force,
-                r.haptic
+                r.haptic,
+                r.display_period
             );
         }
         s

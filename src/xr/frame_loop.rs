@@ -75,6 +75,15 @@ pub struct LoopOutcome {
     pub max_haptic: f32,
     /// Simulated time given up to keep the display on time, s.
     pub dropped_time: f64,
+    /// Display refreshes the session's frames missed because a frame came late: the
+    /// predicted display times of consecutive frames are this many nominal display
+    /// periods more than one apart (a runtime may also stretch the period it predicts
+    /// for a slow app; the nominal period is the shortest it predicted).
+    pub dropped_frames: u64,
+    /// The nominal display rate: the highest the runtime predicted, Hz.
+    pub display_hz: f64,
+    /// Wall time of the session loop, s.
+    pub wall_s: f64,
     /// Fewest substeps used.
     pub min_substeps_used: u32,
     /// Times the solver failed and the scene was reset.
@@ -142,6 +151,9 @@ pub fn run_loop(
         max_tool_force: 0.0,
         max_haptic: 0.0,
         dropped_time: 0.0,
+        dropped_frames: 0,
+        display_hz: 0.0,
+        wall_s: 0.0,
         min_substeps_used: nominal,
         solver_resets: 0,
         exit: None,
@@ -158,6 +170,7 @@ pub fn run_loop(
     let mut exit_asked = false;
     let mut inject_nan_at = opts.inject_nan_at;
     let mut haptics = HapticGate::default();
+    let session_start = Instant::now();
     // Every frame runs inside this closure so that a failure mid-frame still ends with
     // the stroke, the frame log and the report saved.
     let mut session = || -> Result<()> {
@@ -353,6 +366,7 @@ pub fn run_loop(
                 engaged,
                 tool_force: force,
                 haptic: sent,
+                display_period: frame.display_period,
             });
             out.frames += 1;
             // Ctrl-C ends the session the way the runtime expects (xrRequestExitSession),
@@ -372,6 +386,8 @@ pub fn run_loop(
     };
 
     let ended = session();
+    out.wall_s = session_start.elapsed().as_secs_f64();
+    (out.display_hz, out.dropped_frames) = missed_refreshes(&out.log.rows);
     // An attempt the blade touched is scored and saved however the session ended.
     let saved = match exercise {
         Some(ex) => ex.end_session(xr),
@@ -428,6 +444,27 @@ pub fn run_loop(
     Ok(out)
 }
 
+/// The nominal display rate (Hz, from the shortest predicted period) and the display
+/// refreshes missed between the logged frames at that rate.
+pub fn missed_refreshes(rows: &[FrameRow]) -> (f64, u64) {
+    let nominal = rows
+        .iter()
+        .map(|r| r.display_period)
+        .filter(|p| *p > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if !nominal.is_finite() {
+        return (0.0, 0);
+    }
+    let missed = rows
+        .windows(2)
+        .map(|w| {
+            let periods = ((w[1].display_time - w[0].display_time) / nominal).round();
+            (periods.max(0.0) as u64).saturating_sub(1)
+        })
+        .sum();
+    (1.0 / nominal, missed)
+}
+
 /// The scene back to rest, and a new exercise attempt on it.
 fn restart(
     xr: &mut XrBody,
@@ -440,4 +477,29 @@ fn restart(
         ex.start(xr, skin, dev)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refreshes_missed_are_counted_at_the_shortest_predicted_period() {
+        let row = |t: f64, p: f64| FrameRow {
+            display_time: t,
+            display_period: p,
+            ..Default::default()
+        };
+        // 20 Hz: on time, one refresh missed, then a stretched 0.2 s period (three).
+        let rows = [
+            row(0.0, 0.05),
+            row(0.05, 0.05),
+            row(0.15, 0.05),
+            row(0.35, 0.2),
+        ];
+        let (hz, missed) = missed_refreshes(&rows);
+        assert!((hz - 20.0).abs() < 1e-9);
+        assert_eq!(missed, 4);
+        assert_eq!(missed_refreshes(&[]), (0.0, 0));
+    }
 }

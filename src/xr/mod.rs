@@ -88,6 +88,12 @@ pub struct XrReport {
     pub haptic_stops: u64,
     /// Simulated time given up, s.
     pub dropped_time_s: f64,
+    /// The display rate the runtime reported, Hz.
+    pub display_hz: f64,
+    /// Display frames the runtime skipped because a frame came late.
+    pub dropped_frames: u64,
+    /// Simulation frames stepped per second of wall time.
+    pub sim_steps_per_s: f64,
     /// Scene substeps and the fewest used.
     pub substeps: (u32, u32),
     /// Median and 95th-percentile wall time of rendered frames, ms.
@@ -251,6 +257,13 @@ fn run_session(
         haptic_pulses: outcome.haptic_pulses,
         haptic_stops: outcome.haptic_stops,
         dropped_time_s: outcome.dropped_time,
+        display_hz: outcome.display_hz,
+        dropped_frames: outcome.dropped_frames,
+        sim_steps_per_s: if outcome.wall_s > 0.0 {
+            outcome.sim_frames as f64 / outcome.wall_s
+        } else {
+            0.0
+        },
         substeps: (xr.nominal_substeps(), outcome.min_substeps_used),
         frame_ms_p50_p95: quant(0.5).zip(quant(0.95)),
         solver_resets: outcome.solver_resets,
