@@ -133,7 +133,10 @@ fn ctrl_c_while_focused_ends_the_session_through_the_runtime_and_exits_130() {
     assert_eq!(states.last().unwrap(), "Exiting", "{r}");
     assert!(states.iter().any(|s| s == "Stopping"), "{r}");
     assert!(r["frames"].as_u64().unwrap() > 0, "{r}");
-    assert!(out.join("stroke.ron").is_file() && out.join("frames.csv").is_file());
+    assert!(out.join("frames.csv").is_file());
+    // (A stroke needs two simulation frames; a Ctrl-C at once may leave only one.)
+    let sim = r["sim_frames"].as_u64().unwrap();
+    assert_eq!(out.join("stroke.ron").is_file(), sim >= 2, "{r}");
 }
 
 fn output(mut c: Command) -> Output {

@@ -68,7 +68,7 @@ pub struct LoopOutcome {
     pub released_tets: usize,
     /// Bounding box (min, max corners, sim world, m) of the released tets' rest
     /// centroids: where the cut is.
-    pub cut_box: Option<([f32; 3], [f32; 3])>,
+    pub cut_box: Option<super::xr_body::CutBox>,
     /// Largest tool contact force, N.
     pub max_tool_force: f32,
     /// Largest vibration amplitude sent.
@@ -387,7 +387,7 @@ pub fn run_loop(
 
     let ended = session();
     out.wall_s = session_start.elapsed().as_secs_f64();
-    (out.display_hz, out.dropped_frames) = missed_refreshes(&out.log.rows);
+    (out.display_hz, out.dropped_frames) = out.log.missed_refreshes();
     // An attempt the blade touched is scored and saved however the session ended.
     let saved = match exercise {
         Some(ex) => ex.end_session(xr),
@@ -419,50 +419,13 @@ pub fn run_loop(
     }
     out.session_states = headset.session_states().to_vec();
     out.dropped_time = pacer.dropped_time();
-    let mesh = xr.solver().mesh();
-    let released: Vec<glam::Vec3> = (0..mesh.tet_count())
-        .filter(|&i| !xr.solver().cut().is_live(i))
-        .map(|i| {
-            mesh.tets[i]
-                .iter()
-                .map(|&n| mesh.rest_positions[n as usize])
-                .sum::<glam::Vec3>()
-                * 0.25
-        })
-        .collect();
-    out.released_tets = released.len();
-    out.cut_box = released
-        .iter()
-        .fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, &c| {
-            let (lo, hi) = b.unwrap_or((c, c));
-            Some((lo.min(c), hi.max(c)))
-        })
-        .map(|(lo, hi)| (lo.to_array(), hi.to_array()));
-    if opts.record && !recorder.is_empty() {
+    (out.released_tets, out.cut_box) = xr.cut_extent();
+    // A stroke needs two poses: a session that ended after one simulation frame (Ctrl-C
+    // at once) has none to save, and its report is still written.
+    if opts.record && recorder.len() >= 2 {
         out.stroke = Some(recorder.finish()?);
     }
     Ok(out)
-}
-
-/// The nominal display rate (Hz, from the shortest predicted period) and the display
-/// refreshes missed between the logged frames at that rate.
-pub fn missed_refreshes(rows: &[FrameRow]) -> (f64, u64) {
-    let nominal = rows
-        .iter()
-        .map(|r| r.display_period)
-        .filter(|p| *p > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    if !nominal.is_finite() {
-        return (0.0, 0);
-    }
-    let missed = rows
-        .windows(2)
-        .map(|w| {
-            let periods = ((w[1].display_time - w[0].display_time) / nominal).round();
-            (periods.max(0.0) as u64).saturating_sub(1)
-        })
-        .sum();
-    (1.0 / nominal, missed)
 }
 
 /// The scene back to rest, and a new exercise attempt on it.
@@ -477,29 +440,4 @@ fn restart(
         ex.start(xr, skin, dev)?;
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn refreshes_missed_are_counted_at_the_shortest_predicted_period() {
-        let row = |t: f64, p: f64| FrameRow {
-            display_time: t,
-            display_period: p,
-            ..Default::default()
-        };
-        // 20 Hz: on time, one refresh missed, then a stretched 0.2 s period (three).
-        let rows = [
-            row(0.0, 0.05),
-            row(0.05, 0.05),
-            row(0.15, 0.05),
-            row(0.35, 0.2),
-        ];
-        let (hz, missed) = missed_refreshes(&rows);
-        assert!((hz - 20.0).abs() < 1e-9);
-        assert_eq!(missed, 4);
-        assert_eq!(missed_refreshes(&[]), (0.0, 0));
-    }
 }

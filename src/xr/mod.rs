@@ -77,7 +77,7 @@ pub struct XrReport {
     pub released_tets: usize,
     /// Where the cut is: the bounding box (min, max, sim world, m) of the released tets'
     /// rest centroids.
-    pub cut_box: Option<([f32; 3], [f32; 3])>,
+    pub cut_box: Option<xr_body::CutBox>,
     /// Largest tool force, N.
     pub max_tool_force: f32,
     /// Largest vibration amplitude.
