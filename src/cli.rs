@@ -124,6 +124,11 @@ pub enum Command {
         /// frame is rolled back, an exercise attempt saved, the scene reset).
         #[arg(long, value_name = "N")]
         inject_nan_at: Option<u64>,
+        /// Drive the scalpel along this recorded stroke (RON, e.g. a session's stroke.ron)
+        /// in simulation time instead of the right controller, blade engaged; the session
+        /// ends when the stroke has been played (for demos and tests).
+        #[arg(long, value_name = "FILE")]
+        stroke: Option<PathBuf>,
     },
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {

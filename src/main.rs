@@ -124,6 +124,7 @@ fn main() -> ExitCode {
             exercise,
             history,
             inject_nan_at,
+            stroke,
         } => incise::xr::run(&incise::xr::XrOptions {
             scene: scene.unwrap_or_else(|| XR_SCENE.into()),
             simulated: simulated_headset,
@@ -134,6 +135,7 @@ fn main() -> ExitCode {
             exercise,
             history,
             inject_nan_at,
+            stroke,
         })
         .map(|r| println!("{}", r.summary())),
         Command::Render {

@@ -491,3 +491,29 @@ fn a_solver_failure_saves_the_attempt_before_the_scene_is_reset() {
         assert!(dir.join("result.json").exists() && dir.join("stroke.ron").exists());
     }
 }
+
+/// A session that ends after a single simulation frame has no stroke to save (a stroke
+/// needs two poses): it still ends cleanly with its report (found by Ctrl-C at once on
+/// Monado, where it failed with "a stroke needs at least 2 poses" and wrote no report).
+#[test]
+fn a_session_of_one_simulation_frame_writes_its_report_without_a_stroke() {
+    let script = r#"(
+        display_hz: 72.0,
+        duration: 0.02,
+        eye_size: (64, 64),
+        render_every: 1000,
+        pacing: Nominal,
+        head: [(t: 0.0, position: (0.0, 1.25, -0.05), orientation: (-0.34202, 0.0, 0.0, 0.93969))],
+        right: Some(Tool(
+            start: 0.0,
+            stroke: Incision((start: (0.015, 0.02, 0.02), end: (0.055, 0.02, 0.02), depth: 0.005, speed: 0.02, approach: 0.005)),
+        )),
+    )"#;
+    let (o, out) = run_xr("xr-one-frame", script, &["config/plate_cut.ron"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let r = xr_report(&out, &o);
+    assert_eq!(r["sim_frames"].as_u64(), Some(1), "{r}");
+    assert_eq!(r["exit"], "Exited");
+    assert!(r["stroke"].is_null(), "{r}");
+    assert!(!out.join("stroke.ron").exists());
+}

@@ -31,6 +31,8 @@ pub struct FrameRow {
     pub tool_force: f32,
     /// Vibration amplitude sent, 0..1.
     pub haptic: f32,
+    /// The runtime's predicted display period for this frame, s.
+    pub display_period: f64,
 }
 
 /// The rows of a session.
@@ -44,12 +46,12 @@ impl FrameLog {
     /// The log as CSV with a header line.
     pub fn to_csv(&self) -> String {
         let mut s = String::from(
-            "frame,display_time_s,sim_frames,substeps,sim_ms,render_ms,frame_ms,rendered,engaged,tool_force_n,haptic\n",
+            "frame,display_time_s,sim_frames,substeps,sim_ms,render_ms,frame_ms,rendered,engaged,tool_force_n,haptic,display_period_s\n",
         );
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{},{:.6},{},{},{:.3},{:.3},{:.3},{},{},{:.4},{:.3}",
+                "{},{:.6},{},{},{:.3},{:.3},{:.3},{},{},{:.4},{:.3},{:.6}",
                 r.frame,
                 r.display_time,
                 r.sim_frames,
@@ -60,7 +62,8 @@ impl FrameLog {
                 u8::from(r.rendered),
                 u8::from(r.engaged),
                 r.tool_force,
-                r.haptic
+                r.haptic,
+                r.display_period
             );
         }
         s
@@ -70,6 +73,30 @@ impl FrameLog {
     pub fn save(&self, path: &Path) -> Result<()> {
         incise_sim::io::write_atomic(path, self.to_csv().as_bytes())
             .with_context(|| format!("writing {}", path.display()))
+    }
+
+    /// The nominal display rate (Hz, from the shortest predicted period) and the display
+    /// refreshes missed between the logged frames at that rate (a frame that came late
+    /// is shown one or more refreshes after the one before it plus one).
+    pub fn missed_refreshes(&self) -> (f64, u64) {
+        let nominal = self
+            .rows
+            .iter()
+            .map(|r| r.display_period)
+            .filter(|p| *p > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        if !nominal.is_finite() {
+            return (0.0, 0);
+        }
+        let missed = self
+            .rows
+            .windows(2)
+            .map(|w| {
+                let periods = ((w[1].display_time - w[0].display_time) / nominal).round();
+                (periods.max(0.0) as u64).saturating_sub(1)
+            })
+            .sum();
+        (1.0 / nominal, missed)
     }
 
     /// The `q`-quantile (0..1) of frame wall times, ms, over rendered frames.
@@ -109,5 +136,27 @@ mod tests {
         assert!(csv.starts_with("frame,display_time_s"));
         assert_eq!(log.frame_ms_quantile(0.5), Some(20.0));
         assert_eq!(log.frame_ms_quantile(1.0), Some(30.0));
+    }
+
+    #[test]
+    fn refreshes_missed_are_counted_at_the_shortest_predicted_period() {
+        let row = |t: f64, p: f64| FrameRow {
+            display_time: t,
+            display_period: p,
+            ..Default::default()
+        };
+        // 20 Hz: on time, one refresh missed, then a stretched 0.2 s period (three).
+        let log = FrameLog {
+            rows: vec![
+                row(0.0, 0.05),
+                row(0.05, 0.05),
+                row(0.15, 0.05),
+                row(0.35, 0.2),
+            ],
+        };
+        let (hz, missed) = log.missed_refreshes();
+        assert!((hz - 20.0).abs() < 1e-9);
+        assert_eq!(missed, 4);
+        assert_eq!(FrameLog::default().missed_refreshes(), (0.0, 0));
     }
 }

@@ -1,7 +1,8 @@
 //! The XR frame loop, the same for the OpenXR session and the simulated headset: per
-//! display frame, controller input → tray and scalpel, the pacer's simulation frames
-//! (fixed dt, substeps cut before time when late), vibration from the contact force, both
-//! eyes rendered into the headset's targets, and a frame-time row.
+//! display frame, controller input → tray and scalpel (or a recorded stroke in simulation
+//! time), the pacer's simulation frames (fixed dt, substeps cut before time when late),
+//! vibration from the contact force, both eyes rendered into the headset's targets, and a
+//! frame-time row.
 
 use std::time::Instant;
 
@@ -12,8 +13,8 @@ use incise_sim::skin::Skin;
 use incise_xr::frame::{ToolState, pinned_nodes};
 use incise_xr::openxr::controls::{ControllerState, commands};
 use incise_xr::openxr::eye::eye_view;
-use incise_xr::openxr::haptics::haptic_pulse;
-use incise_xr::openxr::lifecycle::ExitReason;
+use incise_xr::openxr::haptics::{HapticCall, HapticGate, haptic_pulse};
+use incise_xr::openxr::lifecycle::{ExitReason, SessionPhase};
 use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
 use incise_xr::openxr::tray::Tray;
@@ -50,6 +51,9 @@ pub struct LoopOptions<'a> {
     /// Testing aid: a NaN in the solver just before this simulation frame of the session
     /// (the frame fails, is rolled back and the scene reset).
     pub inject_nan_at: Option<u64>,
+    /// Drive the scalpel along this stroke (sim world, simulation time), engaged, instead
+    /// of the right controller; the session ends when the stroke has been played.
+    pub stroke: Option<&'a Stroke>,
 }
 
 /// What a session did.
@@ -62,18 +66,39 @@ pub struct LoopOutcome {
     pub sim_frames: u64,
     /// Released tets at the end.
     pub released_tets: usize,
+    /// Bounding box (min, max corners, sim world, m) of the released tets' rest
+    /// centroids: where the cut is.
+    pub cut_box: Option<super::xr_body::CutBox>,
     /// Largest tool contact force, N.
     pub max_tool_force: f32,
     /// Largest vibration amplitude sent.
     pub max_haptic: f32,
     /// Simulated time given up to keep the display on time, s.
     pub dropped_time: f64,
+    /// Display refreshes the session's frames missed because a frame came late: the
+    /// predicted display times of consecutive frames are this many nominal display
+    /// periods more than one apart (a runtime may also stretch the period it predicts
+    /// for a slow app; the nominal period is the shortest it predicted).
+    pub dropped_frames: u64,
+    /// The nominal display rate: the highest the runtime predicted, Hz.
+    pub display_hz: f64,
+    /// Wall time of the session loop, s.
+    pub wall_s: f64,
     /// Fewest substeps used.
     pub min_substeps_used: u32,
     /// Times the solver failed and the scene was reset.
     pub solver_resets: u32,
     /// How the session ended (`None`: the runtime never made it ready).
     pub exit: Option<ExitReason>,
+    /// Whether Ctrl-C (or SIGTERM) ended it.
+    pub interrupted: bool,
+    /// Vibration pulses sent (`xrApplyHapticFeedback`).
+    pub haptic_pulses: u64,
+    /// Vibration stops sent (`xrStopHapticFeedback`): one each time the blade left the
+    /// tissue, and one at the end if it was still vibrating.
+    pub haptic_stops: u64,
+    /// The session states, in order.
+    pub session_states: Vec<SessionPhase>,
     /// The scalpel's path, when recorded and the controller was tracked.
     pub stroke: Option<Stroke>,
     /// Per-frame times.
@@ -122,12 +147,20 @@ pub fn run_loop(
         rendered: 0,
         sim_frames: 0,
         released_tets: 0,
+        cut_box: None,
         max_tool_force: 0.0,
         max_haptic: 0.0,
         dropped_time: 0.0,
+        dropped_frames: 0,
+        display_hz: 0.0,
+        wall_s: 0.0,
         min_substeps_used: nominal,
         solver_resets: 0,
         exit: None,
+        interrupted: false,
+        haptic_pulses: 0,
+        haptic_stops: 0,
+        session_states: Vec::new(),
         stroke: None,
         log: FrameLog::default(),
         error: None,
@@ -136,11 +169,17 @@ pub fn run_loop(
     let mut idle = 0;
     let mut exit_asked = false;
     let mut inject_nan_at = opts.inject_nan_at;
+    let mut haptics = HapticGate::default();
+    let session_start = Instant::now();
     // Every frame runs inside this closure so that a failure mid-frame still ends with
     // the stroke, the frame log and the report saved.
     let mut session = || -> Result<()> {
         if let Some(ex) = exercise.as_deref_mut() {
             ex.start(xr, skin, &dev)?;
+        }
+        if let Some(s) = opts.stroke {
+            // The blade starts where the stroke does (as `incise run --stroke` places it).
+            xr.drive_tool(Some(s.pose_at(0.0)), true)?;
         }
         loop {
             let frame = match headset.next_frame()? {
@@ -149,6 +188,13 @@ pub fn run_loop(
                     break;
                 }
                 FrameEvent::Idle => {
+                    // Ctrl-C before the runtime runs the session (or between runs): the
+                    // lifecycle ends a session that is not running at once.
+                    if !exit_asked && crate::interrupt::requested() {
+                        exit_asked = true;
+                        out.interrupted = true;
+                        headset.request_exit()?;
+                    }
                     idle += 1;
                     if idle > MAX_IDLE {
                         break;
@@ -179,7 +225,7 @@ pub fn run_loop(
                 tray = tray.placed_at(grip);
             }
             tray = tray.steered(c.stick, frame.display_period as f32);
-            let engaged = c.blade_engaged();
+            let engaged = opts.stroke.is_some() || c.blade_engaged();
             let tool_pose = c.right_grip.map(|g| scalpel_pose(g, opts.blade, &tray));
 
             // Simulation: the pacer's frames at the fixed dt, never waiting for the display.
@@ -194,6 +240,12 @@ pub fn run_loop(
             let mut force = 0.0f32;
             let mut stepped = 0u64;
             for _ in 0..plan.sim_frames {
+                // A stroke is played in simulation time: the pose at the end of this frame,
+                // as `incise run --stroke` moves it.
+                let tool_pose = match opts.stroke {
+                    Some(s) => Some(s.pose_at(sim_time + sim_dt)),
+                    None => tool_pose,
+                };
                 xr.drive_tool(tool_pose, engaged)?;
                 if inject_nan_at == Some(out.sim_frames + stepped) {
                     inject_nan_at = None;
@@ -235,7 +287,17 @@ pub fn run_loop(
 
             let amplitude = (opts.haptic)(force);
             let pulse = haptic_pulse(amplitude, engaged, frame.display_period);
-            headset.vibrate(pulse)?;
+            match haptics.next(pulse) {
+                HapticCall::Apply(p) => {
+                    headset.vibrate(Some(p))?;
+                    out.haptic_pulses += 1;
+                }
+                HapticCall::Stop => {
+                    headset.vibrate(None)?;
+                    out.haptic_stops += 1;
+                }
+                HapticCall::Nothing => {}
+            }
             let sent = pulse.map_or(0.0, |p| p.amplitude);
             out.max_haptic = out.max_haptic.max(sent);
 
@@ -304,15 +366,19 @@ pub fn run_loop(
                 engaged,
                 tool_force: force,
                 haptic: sent,
+                display_period: frame.display_period,
             });
             out.frames += 1;
             // Ctrl-C ends the session the way the runtime expects (xrRequestExitSession),
-            // so the stroke and report are saved as after any other end.
+            // so the stroke and report are saved as after any other end; so do the frame
+            // limit and the end of a played stroke.
+            let interrupted = crate::interrupt::requested();
+            let stroke_done = opts.stroke.is_some_and(|s| sim_time >= s.end_time());
             if !exit_asked
-                && (opts.max_frames.is_some_and(|m| out.frames >= m)
-                    || crate::interrupt::requested())
+                && (interrupted || stroke_done || opts.max_frames.is_some_and(|m| out.frames >= m))
             {
                 exit_asked = true;
+                out.interrupted = interrupted;
                 headset.request_exit()?;
             }
         }
@@ -320,6 +386,8 @@ pub fn run_loop(
     };
 
     let ended = session();
+    out.wall_s = session_start.elapsed().as_secs_f64();
+    (out.display_hz, out.dropped_frames) = out.log.missed_refreshes();
     // An attempt the blade touched is scored and saved however the session ended.
     let saved = match exercise {
         Some(ex) => ex.end_session(xr),
@@ -345,12 +413,16 @@ pub fn run_loop(
         }
     }
     // The controller may be gone with the session: stopping its vibration can fail.
-    let _ = headset.vibrate(None);
+    if haptics.vibrating() {
+        let _ = headset.vibrate(None);
+        out.haptic_stops += 1;
+    }
+    out.session_states = headset.session_states().to_vec();
     out.dropped_time = pacer.dropped_time();
-    out.released_tets = (0..xr.solver().mesh().tet_count())
-        .filter(|&i| !xr.solver().cut().is_live(i))
-        .count();
-    if opts.record && !recorder.is_empty() {
+    (out.released_tets, out.cut_box) = xr.cut_extent();
+    // A stroke needs two poses: a session that ended after one simulation frame (Ctrl-C
+    // at once) has none to save, and its report is still written.
+    if opts.record && recorder.len() >= 2 {
         out.stroke = Some(recorder.finish()?);
     }
     Ok(out)

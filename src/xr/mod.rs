@@ -51,6 +51,9 @@ pub struct XrOptions {
     pub history: PathBuf,
     /// Testing aid: a NaN in the solver just before this simulation frame.
     pub inject_nan_at: Option<u64>,
+    /// Drive the scalpel along this recorded stroke (simulation time) instead of the
+    /// right controller; the session ends when it has been played.
+    pub stroke: Option<PathBuf>,
 }
 
 /// The session summary written as `xr_report.json`.
@@ -68,14 +71,29 @@ pub struct XrReport {
     pub rendered: u64,
     /// Simulation frames.
     pub sim_frames: u64,
+    /// The session states the runtime reported, in order (IDLE first).
+    pub session_states: Vec<String>,
     /// Released tets at the end.
     pub released_tets: usize,
+    /// Where the cut is: the bounding box (min, max, sim world, m) of the released tets'
+    /// rest centroids.
+    pub cut_box: Option<xr_body::CutBox>,
     /// Largest tool force, N.
     pub max_tool_force: f32,
     /// Largest vibration amplitude.
     pub max_haptic: f32,
+    /// Vibration pulses sent.
+    pub haptic_pulses: u64,
+    /// Vibration stops sent (once each time the blade left the tissue).
+    pub haptic_stops: u64,
     /// Simulated time given up, s.
     pub dropped_time_s: f64,
+    /// The display rate the runtime reported, Hz.
+    pub display_hz: f64,
+    /// Display frames the runtime skipped because a frame came late.
+    pub dropped_frames: u64,
+    /// Simulation frames stepped per second of wall time.
+    pub sim_steps_per_s: f64,
     /// Scene substeps and the fewest used.
     pub substeps: (u32, u32),
     /// Median and 95th-percentile wall time of rendered frames, ms.
@@ -86,6 +104,8 @@ pub struct XrReport {
     pub exit: String,
     /// The recorded stroke, if any.
     pub stroke: Option<String>,
+    /// The stroke file that drove the scalpel (`--stroke`), if any.
+    pub played_stroke: Option<String>,
     /// The exercise file, in an exercise session.
     pub exercise: Option<String>,
     /// The exercise attempts finished and saved in the session.
@@ -180,6 +200,13 @@ fn run_session(
         .with_context(|| format!("creating {}", opts.out.display()))?;
     let curve = HapticCurve::default();
     let haptic = move |f: f32| curve.amplitude(f);
+    let played = opts
+        .stroke
+        .as_ref()
+        .map(|p| {
+            incise_scalpel::load_stroke(p).with_context(|| format!("--stroke {}", p.display()))
+        })
+        .transpose()?;
     let describe = headset.describe();
     eprintln!("xr: {describe}");
     let mut outcome: LoopOutcome = run_loop(
@@ -190,10 +217,13 @@ fn run_session(
             max_frames: opts.frames,
             blade: BladeOffset::default(),
             haptic: &haptic,
-            nominal_pacing,
+            // A played stroke keeps the scene's substeps, so its recording replays with
+            // `incise run --stroke` through the same physics.
+            nominal_pacing: nominal_pacing || played.is_some(),
             record: true,
             tray,
             inject_nan_at: opts.inject_nan_at,
+            stroke: played.as_ref(),
         },
         exercise.as_deref_mut(),
     )?;
@@ -215,19 +245,36 @@ fn run_session(
         frames: outcome.frames,
         rendered: outcome.rendered,
         sim_frames: outcome.sim_frames,
+        session_states: outcome
+            .session_states
+            .iter()
+            .map(|p| format!("{p:?}"))
+            .collect(),
         released_tets: outcome.released_tets,
+        cut_box: outcome.cut_box,
         max_tool_force: outcome.max_tool_force,
         max_haptic: outcome.max_haptic,
+        haptic_pulses: outcome.haptic_pulses,
+        haptic_stops: outcome.haptic_stops,
         dropped_time_s: outcome.dropped_time,
+        display_hz: outcome.display_hz,
+        dropped_frames: outcome.dropped_frames,
+        sim_steps_per_s: if outcome.wall_s > 0.0 {
+            outcome.sim_frames as f64 / outcome.wall_s
+        } else {
+            0.0
+        },
         substeps: (xr.nominal_substeps(), outcome.min_substeps_used),
         frame_ms_p50_p95: quant(0.5).zip(quant(0.95)),
         solver_resets: outcome.solver_resets,
         exit: match (&outcome.error, outcome.exit) {
             (Some(e), _) => format!("failed: {e:#}"),
+            (None, _) if outcome.interrupted => "Interrupted".into(),
             (None, Some(e)) => format!("{e:?}"),
             (None, None) => "the runtime never made the session ready".into(),
         },
         stroke: stroke_path,
+        played_stroke: opts.stroke.as_ref().map(|p| p.display().to_string()),
         exercise: opts.exercise.as_ref().map(|p| p.display().to_string()),
         attempts: exercise.map(|e| e.attempts.clone()).unwrap_or_default(),
     };
@@ -241,6 +288,13 @@ fn run_session(
             outcome.frames,
             opts.out.display()
         ))),
+        // Ctrl-C: the session ended cleanly, but the run was cut short (exit 130).
+        None if outcome.interrupted => Err(crate::interrupt::Interrupted {
+            what: format!("the XR session on {}", report.scene),
+            frames: outcome.frames,
+            out: opts.out.display().to_string(),
+        }
+        .into()),
         None => Ok(report),
     }
 }

@@ -313,4 +313,8 @@ impl Headset for SimulatedHeadset {
         self.stop();
         Ok(())
     }
+
+    fn session_states(&self) -> &[SessionPhase] {
+        self.lifecycle.history()
+    }
 }

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use incise_xr::openxr::XrError;
+use incise_xr::openxr::manifest::ActiveRuntime;
 
 /// `incise xr` could not find a usable runtime or headset; main exits 2 with this text.
 #[derive(Debug)]
@@ -24,9 +25,22 @@ pub fn message(error: &XrError, scene: &Path) -> String {
         XrError::LoaderMissing(detail) => format!(
             "the OpenXR loader library (libopenxr_loader.so.1 on Linux, openxr_loader.dll on Windows) is not installed, so no runtime could be looked for ({detail}); on Debian or Ubuntu install it with `sudo apt install libopenxr-loader1`, on Windows it comes with the runtime"
         ),
-        XrError::RuntimeUnavailable(detail) => format!(
-            "the OpenXR loader is installed but no active OpenXR runtime is registered ({detail})"
-        ),
+        XrError::RuntimeUnavailable { detail, manifest } => match manifest {
+            ActiveRuntime::None => format!(
+                "the OpenXR loader is installed but no active OpenXR runtime is registered ({detail})"
+            ),
+            ActiveRuntime::Env {
+                path,
+                exists: false,
+            } => format!(
+                "XR_RUNTIME_JSON names the runtime manifest {}, which does not exist ({detail})",
+                path.display()
+            ),
+            found => format!(
+                "the runtime manifest {} was found but the OpenXR loader could not load the runtime it names ({detail}; the loader's message above says why)",
+                found.describe()
+            ),
+        },
         XrError::NoVulkan { runtime } => format!(
             "the active OpenXR runtime is {runtime}, but it cannot render with Vulkan (it lacks XR_KHR_vulkan_enable2, which incise needs)"
         ),
@@ -62,8 +76,30 @@ mod tests {
                 "loader library",
             ),
             (
-                XrError::RuntimeUnavailable("XR_ERROR_RUNTIME_UNAVAILABLE".into()),
+                XrError::RuntimeUnavailable {
+                    detail: "XR_ERROR_RUNTIME_UNAVAILABLE".into(),
+                    manifest: ActiveRuntime::None,
+                },
                 "no active OpenXR runtime",
+            ),
+            (
+                XrError::RuntimeUnavailable {
+                    detail: "XR_ERROR_RUNTIME_UNAVAILABLE".into(),
+                    manifest: ActiveRuntime::Env {
+                        path: "/opt/monado.json".into(),
+                        exists: false,
+                    },
+                },
+                "XR_RUNTIME_JSON names the runtime manifest /opt/monado.json, which does not exist",
+            ),
+            (
+                XrError::RuntimeUnavailable {
+                    detail: "XR_ERROR_RUNTIME_UNAVAILABLE".into(),
+                    manifest: ActiveRuntime::Registered(
+                        "/etc/xdg/openxr/1/active_runtime.json".into(),
+                    ),
+                },
+                "manifest /etc/xdg/openxr/1/active_runtime.json was found but the OpenXR loader could not load",
             ),
             (
                 XrError::NoVulkan {

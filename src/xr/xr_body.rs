@@ -17,6 +17,9 @@ use crate::body::{Body, DeviceChoice};
 use crate::scene::{BuiltScene, Scene, build_scene, load_scene};
 use crate::screenshots::place_on;
 
+/// A bounding box: its min and max corners (sim world, m).
+pub type CutBox = ([f32; 3], [f32; 3]);
+
 /// The scalpel used when the scene names none, relative to the scene file.
 pub const DEFAULT_TOOL: &str = "tools/scalpel_10.ron";
 
@@ -148,6 +151,31 @@ impl XrBody {
     /// The scene file.
     pub fn scene_path(&self) -> &Path {
         &self.path
+    }
+
+    /// The released tets, and the bounding box (min, max corners, sim world, m) of their
+    /// rest centroids: how much was cut and where.
+    pub fn cut_extent(&self) -> (usize, Option<CutBox>) {
+        let solver = self.solver();
+        let mesh = solver.mesh();
+        let centroids: Vec<Vec3> = (0..mesh.tet_count())
+            .filter(|&i| !solver.cut().is_live(i))
+            .map(|i| {
+                mesh.tets[i]
+                    .iter()
+                    .map(|&n| mesh.rest_positions[n as usize])
+                    .sum::<Vec3>()
+                    * 0.25
+            })
+            .collect();
+        let bounds = centroids
+            .iter()
+            .fold(None, |b: Option<(Vec3, Vec3)>, &c| {
+                let (lo, hi) = b.unwrap_or((c, c));
+                Some((lo.min(c), hi.max(c)))
+            })
+            .map(|(lo, hi)| (lo.to_array(), hi.to_array()));
+        (centroids.len(), bounds)
     }
 
     /// The scalpel's last pose, and whether the controller is tracked.

@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+pub mod monado;
+
 /// Run the built `incise` binary from the workspace root with `args`.
 pub fn incise(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_incise"))

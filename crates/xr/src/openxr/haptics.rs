@@ -34,9 +34,71 @@ pub fn haptic_pulse(amplitude: f32, engaged: bool, display_period_s: f64) -> Opt
     })
 }
 
+/// What to tell the controller this frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HapticCall {
+    /// `xrApplyHapticFeedback` with this pulse.
+    Apply(HapticPulse),
+    /// `xrStopHapticFeedback`: the blade has just left the tissue.
+    Stop,
+    /// Nothing: the controller is already still.
+    Nothing,
+}
+
+/// Whether the controller is vibrating: pulses are sent while the blade is in tissue and
+/// one stop after it leaves, not a stop on every frame the blade is out.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct HapticGate {
+    vibrating: bool,
+}
+
+impl HapticGate {
+    /// The call for this frame's pulse (`None`: no vibration wanted).
+    pub fn next(&mut self, pulse: Option<HapticPulse>) -> HapticCall {
+        match (pulse, self.vibrating) {
+            (Some(p), _) => {
+                self.vibrating = true;
+                HapticCall::Apply(p)
+            }
+            (None, true) => {
+                self.vibrating = false;
+                HapticCall::Stop
+            }
+            (None, false) => HapticCall::Nothing,
+        }
+    }
+
+    /// Whether the last call left the controller vibrating (a stop is due at the end).
+    pub fn vibrating(&self) -> bool {
+        self.vibrating
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_stop_after_the_blade_leaves_and_none_while_it_is_out() {
+        let mut g = HapticGate::default();
+        let p = haptic_pulse(0.5, true, 0.01);
+        let calls: Vec<HapticCall> = [None, None, p, p, None, None, None, p, None]
+            .into_iter()
+            .map(|x| g.next(x))
+            .collect();
+        let stops = calls.iter().filter(|c| **c == HapticCall::Stop).count();
+        let applied = calls
+            .iter()
+            .filter(|c| matches!(c, HapticCall::Apply(_)))
+            .count();
+        assert_eq!((applied, stops), (3, 2), "{calls:?}");
+        assert_eq!(calls[0], HapticCall::Nothing);
+        assert_eq!(calls[4], HapticCall::Stop);
+        assert_eq!(calls[5], HapticCall::Nothing);
+        assert!(!g.vibrating());
+        g.next(p);
+        assert!(g.vibrating());
+    }
 
     #[test]
     fn amplitude_passes_through_clamped_only_while_engaged() {

@@ -6,7 +6,7 @@ use super::backdrop::Backdrop;
 use super::controls::ControllerState;
 use super::error::XrError;
 use super::haptics::HapticPulse;
-use super::lifecycle::ExitReason;
+use super::lifecycle::{ExitReason, SessionPhase};
 use super::pose::{Fov, XrPose};
 use crate::device::RenderDevice;
 
@@ -61,4 +61,6 @@ pub trait Headset {
     fn vibrate(&mut self, pulse: Option<HapticPulse>) -> Result<(), XrError>;
     /// Ask to end the session (it ends through the lifecycle).
     fn request_exit(&mut self) -> Result<(), XrError>;
+    /// The session states so far, in order, from the initial IDLE.
+    fn session_states(&self) -> &[SessionPhase];
 }

@@ -104,6 +104,7 @@ pub struct Lifecycle {
     stage: FrameStage,
     finished: Option<ExitReason>,
     unexpected: u32,
+    history: Vec<SessionPhase>,
 }
 
 impl Default for Lifecycle {
@@ -121,6 +122,7 @@ impl Lifecycle {
             stage: FrameStage::Outside,
             finished: None,
             unexpected: 0,
+            history: vec![SessionPhase::Idle],
         }
     }
 
@@ -148,6 +150,12 @@ impl Lifecycle {
     /// they are followed anyway.
     pub fn unexpected_transitions(&self) -> u32 {
         self.unexpected
+    }
+
+    /// Every state the session has been in, in order, from the initial IDLE (the states
+    /// reported after the session ended are not followed and not listed).
+    pub fn history(&self) -> &[SessionPhase] {
+        &self.history
     }
 
     /// Whether the loop should run a frame (`xrWaitFrame`) now.
@@ -187,6 +195,10 @@ impl Lifecycle {
             self.unexpected += 1;
         }
         self.phase = next;
+        // Runtimes report the initial IDLE too; a state is listed once per change.
+        if self.history.last() != Some(&next) {
+            self.history.push(next);
+        }
         match next {
             SessionPhase::Ready if !self.running => {
                 out.push(Directive::BeginSession);
@@ -337,8 +349,24 @@ mod tests {
         assert_eq!(l.on_state(Exiting), vec![Quit(ExitReason::Exited)]);
         assert_eq!(l.finished(), Some(ExitReason::Exited));
         assert_eq!(l.unexpected_transitions(), 0);
+        assert_eq!(
+            l.history(),
+            [
+                Idle,
+                Ready,
+                Synchronized,
+                Visible,
+                Focused,
+                Visible,
+                Synchronized,
+                Stopping,
+                Idle,
+                Exiting
+            ]
+        );
         // Nothing after the end.
         assert!(l.on_state(Ready).is_empty());
+        assert_eq!(l.history().len(), 10);
         assert!(l.begin_frame().is_err());
     }
 

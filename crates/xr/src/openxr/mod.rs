@@ -6,7 +6,7 @@
 //! [`haptics`], [`pacing`] (fixed simulation dt, substeps cut before time),
 //! [`lifecycle`] (session states and the frame in flight), [`bindings`], [`controls`] and
 //! [`backdrop`] (passthrough, alpha blend or an opaque room).
-//! Runtime side: [`runtime`] (loader, instance, headset), [`vulkan`] (Vulkan through the
+//! Runtime side: [`runtime`] (loader, instance, headset), [`manifest`] (which runtime), [`vulkan`] (Vulkan through the
 //! runtime, wrapped into wgpu), [`swapchain`], [`actions`], [`passthrough`], [`session`]. The frame loop
 //! drives any [`headset::Headset`]: the OpenXR session or the app's simulated headset.
 
@@ -19,6 +19,7 @@ pub mod eye;
 pub mod haptics;
 pub mod headset;
 pub mod lifecycle;
+pub mod manifest;
 pub mod pacing;
 pub mod passthrough;
 pub mod pose;

@@ -5,6 +5,7 @@ use ::openxr as xr;
 
 use super::backdrop::Backdrop;
 use super::error::{XrError, xr_call};
+use super::manifest::ActiveRuntime;
 
 /// An OpenXR instance on a runtime with a head-mounted display.
 pub struct Runtime {
@@ -28,7 +29,10 @@ pub fn open_runtime() -> Result<Runtime, XrError> {
         unsafe { xr::Entry::load(&()) }.map_err(|e| XrError::LoaderMissing(e.to_string()))?;
     let available = entry
         .enumerate_extensions()
-        .map_err(|e| XrError::RuntimeUnavailable(e.to_string()))?;
+        .map_err(|e| XrError::RuntimeUnavailable {
+            detail: e.to_string(),
+            manifest: ActiveRuntime::find(),
+        })?;
     let app = xr::ApplicationInfo {
         application_name: "incise",
         application_version: 1,
@@ -42,12 +46,15 @@ pub fn open_runtime() -> Result<Runtime, XrError> {
     let instance = entry
         .create_instance(&app, &wanted, &[], &())
         .map_err(|e| match e {
-            xr::sys::Result::ERROR_RUNTIME_UNAVAILABLE | xr::sys::Result::ERROR_RUNTIME_FAILURE => {
-                XrError::RuntimeUnavailable(e.to_string())
-            }
-            e => XrError::Xr {
-                call: "xrCreateInstance",
-                result: e,
+            // The extensions were listed, so the loader found and loaded the runtime: every
+            // failure but "no runtime" is the runtime's own, named as such.
+            xr::sys::Result::ERROR_RUNTIME_UNAVAILABLE => XrError::RuntimeUnavailable {
+                detail: e.to_string(),
+                manifest: ActiveRuntime::find(),
+            },
+            result => XrError::CreateInstance {
+                result,
+                manifest: ActiveRuntime::find(),
             },
         })?;
     let props = instance

@@ -176,6 +176,7 @@ impl XrSession {
                     None => false,
                     Some(xr::Event::SessionStateChanged(e)) => {
                         if let Some(p) = phase(e.state()) {
+                            eprintln!("xr: session {p:?}");
                             directives = self.lifecycle.on_state(p);
                         }
                         true
@@ -400,5 +401,9 @@ impl Headset for XrSession {
     fn request_exit(&mut self) -> Result<(), XrError> {
         let d = self.lifecycle.request_exit();
         self.execute(d)
+    }
+
+    fn session_states(&self) -> &[SessionPhase] {
+        self.lifecycle.history()
     }
 }

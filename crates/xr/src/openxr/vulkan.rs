@@ -22,6 +22,26 @@ use crate::device::RenderDevice;
 /// semaphores) that the instance then lacks.
 pub const VK_VERSION: u32 = vk::API_VERSION_1_3;
 
+/// Check Vulkan `want` against the runtime's requirements: below its minimum is an error;
+/// above the highest version it was tested with (`maxApiVersionSupported`) the OpenXR
+/// specification lets the app go on, so that is a warning (returned).
+pub fn check_vulkan_version(
+    want: xr::Version,
+    min: xr::Version,
+    max: xr::Version,
+) -> Result<Option<String>, XrError> {
+    if want < min {
+        return Err(XrError::Gpu(format!(
+            "the runtime needs Vulkan {min} or newer; incise renders with Vulkan {want} (wgpu 30)"
+        )));
+    }
+    Ok((want > max).then(|| {
+        format!(
+            "the runtime was tested with Vulkan up to {max}; incise asks for Vulkan {want} (wgpu 30) and goes on, but the runtime may not work with it"
+        )
+    }))
+}
+
 /// Creates the Vulkan instance, picks the physical device and creates the device.
 pub trait VulkanCreator {
     /// Create the instance from `info` (the creator may add extensions).
@@ -74,13 +94,12 @@ impl VulkanCreator for RuntimeVulkan<'_> {
             .graphics_requirements::<xr::Vulkan>(self.system)
             .map_err(xr_call("xrGetVulkanGraphicsRequirements2KHR"))?;
         let want = xr::Version::new(1, 3, 0);
-        if want < reqs.min_api_version_supported
-            || want.major() > reqs.max_api_version_supported.major()
-        {
-            return Err(XrError::Gpu(format!(
-                "the runtime needs Vulkan {} to {}; incise renders with Vulkan 1.3 (wgpu 30)",
-                reqs.min_api_version_supported, reqs.max_api_version_supported
-            )));
+        if let Some(warning) = check_vulkan_version(
+            want,
+            reqs.min_api_version_supported,
+            reqs.max_api_version_supported,
+        )? {
+            eprintln!("xr: warning: {warning}");
         }
         // SAFETY: the loader's vkGetInstanceProcAddr and a valid create-info (caller).
         let raw = unsafe {
@@ -327,5 +346,35 @@ pub fn create_gpu(creator: &impl VulkanCreator) -> Result<XrGpu, XrError> {
             vk_device: raw_device.as_raw(),
             queue_family,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vulkan_below_the_minimum_fails_and_above_the_tested_maximum_warns() {
+        let v = xr::Version::new;
+        let want = v(1, 3, 0);
+        // Monado: 1.0.0 to 1023.1023.1023.
+        assert_eq!(
+            check_vulkan_version(want, v(1, 0, 0), v(1023, 1023, 1023)).unwrap(),
+            None
+        );
+        assert_eq!(
+            check_vulkan_version(want, v(1, 0, 0), v(1, 3, 0)).unwrap(),
+            None
+        );
+        // Same major, lower minor: the old check let this pass silently.
+        let w = check_vulkan_version(want, v(1, 0, 0), v(1, 1, 0))
+            .unwrap()
+            .expect("a warning");
+        assert!(
+            w.contains("up to 1.1.0") && w.contains("asks for Vulkan 1.3.0"),
+            "{w}"
+        );
+        let e = check_vulkan_version(want, v(1, 4, 0), v(2, 0, 0)).unwrap_err();
+        assert!(e.to_string().contains("needs Vulkan 1.4.0 or newer"), "{e}");
     }
 }

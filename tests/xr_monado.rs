@@ -1,0 +1,256 @@
+//! `incise xr` against a real OpenXR runtime (issue 19): Monado, built by
+//! scripts/monado.sh, headless (null compositor, simulated HMD and controllers), with the
+//! OpenXR core and Vulkan validation layers on. The session runs through every state to
+//! EXITING, renders into Monado's swapchains and writes its report and stroke; a recorded
+//! stroke played with `--stroke` cuts the slab along its path through the real runtime,
+//! vibrating only while the blade is in the tissue, and its recording replays headless
+//! with `incise run` to the same cut. Under CI a Monado that cannot be built fails.
+
+mod common;
+
+use common::monado::{self, assert_validation_clean};
+use common::{incise, temp_dir, text};
+use serde_json::Value;
+
+const SCENE: &str = "config/plate_cut.ron";
+
+/// The report's session states.
+fn states(r: &Value) -> Vec<String> {
+    r["session_states"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no session_states: {r}"))
+        .iter()
+        .map(|s| s.as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn a_session_on_monado_runs_from_idle_to_exiting_and_renders_every_frame_it_may() {
+    let Some(manifest) = monado::monado() else {
+        return;
+    };
+    let layers = monado::validation();
+    let dir = temp_dir("xr-monado-session");
+    let out = dir.join("out");
+    let o = monado::run(
+        manifest,
+        &dir,
+        &[
+            "xr",
+            SCENE,
+            "--frames",
+            "30",
+            "--device",
+            "cpu",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        layers,
+    );
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        text(&o.stdout).contains("exit Exited"),
+        "{}",
+        text(&o.stdout)
+    );
+    let r = monado::report(&out, &o);
+    assert!(
+        r["headset"].as_str().unwrap().starts_with("Monado"),
+        "{}",
+        r["headset"]
+    );
+    assert_eq!(r["exit"], "Exited");
+    // The whole lifecycle, as the OpenXR specification orders it.
+    assert_eq!(
+        states(&r),
+        [
+            "Idle",
+            "Ready",
+            "Synchronized",
+            "Visible",
+            "Focused",
+            "Visible",
+            "Synchronized",
+            "Stopping",
+            "Idle",
+            "Exiting"
+        ]
+    );
+    assert_eq!(r["frames"].as_u64(), Some(30), "{r}");
+    // Every frame but the first (begun while SYNCHRONIZED) is rendered and submitted.
+    let rendered = r["rendered"].as_u64().unwrap();
+    assert!(rendered >= 28, "{rendered} of 30 frames rendered: {r}");
+    assert!(r["sim_frames"].as_u64().unwrap() > 0, "{r}");
+    // Monado's simulated controllers are tracked but never pressed: no cut, no vibration.
+    assert_eq!(r["released_tets"].as_u64(), Some(0), "{r}");
+    assert_eq!(r["haptic_pulses"].as_u64(), Some(0), "{r}");
+    assert_eq!(r["haptic_stops"].as_u64(), Some(0), "{r}");
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 31);
+    // Display frames the runtime skipped while incise was late, counted from the
+    // predicted display times at its nominal period (Monado's pacing also stretches the
+    // period of a slow app; with the solver inside the frame loop most frames are late).
+    assert!(r["display_hz"].as_f64().unwrap() > 1.0, "{r}");
+    let rows: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (c[1].parse().unwrap(), c[11].parse().unwrap())
+        })
+        .collect();
+    let nominal = rows.iter().map(|r| r.1).fold(f64::INFINITY, f64::min);
+    assert!(
+        (r["display_hz"].as_f64().unwrap() - 1.0 / nominal).abs() < 1e-3,
+        "{r}"
+    );
+    let skipped: u64 = rows
+        .windows(2)
+        .map(|w| (((w[1].0 - w[0].0) / nominal).round() as u64).saturating_sub(1))
+        .sum();
+    // (The CSV's microsecond times can round a gap across a half period.)
+    let dropped = r["dropped_frames"].as_u64().unwrap();
+    assert!(
+        dropped.abs_diff(skipped) <= 1 + skipped / 50,
+        "{dropped} dropped, {skipped} from frames.csv: {r}"
+    );
+    assert!(
+        dropped > 0,
+        "the solver inside the frame loop is late on lavapipe: {r}"
+    );
+    assert!(r["sim_steps_per_s"].as_f64().unwrap() > 0.0, "{r}");
+    // The fixed grip pose was recorded, and loads as a stroke.
+    let stroke = incise_scalpel::load_stroke(&out.join("stroke.ron")).unwrap();
+    assert!(stroke.keys().len() > 1);
+    assert_validation_clean(&o, &dir, layers);
+}
+
+/// The tet count in `incise run`'s summary line ("… N tets released …").
+fn released_in_summary(summary: &str) -> f64 {
+    let words: Vec<&str> = summary.split_whitespace().collect();
+    words
+        .windows(2)
+        .find(|w| w[1] == "tets")
+        .and_then(|w| w[0].parse().ok())
+        .unwrap_or_else(|| panic!("no tet count in {summary}"))
+}
+
+/// Frames of the log's `haptic` column where the vibration went from on to off.
+fn haptic_endings(csv: &str) -> u64 {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "haptic").unwrap();
+    let mut on = false;
+    let mut endings = 0;
+    for l in lines {
+        let now = l.split(',').nth(col).unwrap().parse::<f64>().unwrap() > 0.0;
+        if on && !now {
+            endings += 1;
+        }
+        on = now;
+    }
+    endings + u64::from(on)
+}
+
+#[test]
+fn a_stroke_played_through_monado_cuts_along_it_and_replays_to_the_same_cut() {
+    let Some(manifest) = monado::monado() else {
+        return;
+    };
+    let layers = monado::validation();
+    let dir = temp_dir("xr-monado-stroke");
+    // The scene's own incision (x 1.5 → 5.5 cm at y = 2 cm, 5 mm deep), its first 1.5 s
+    // recorded headless.
+    let stroke = dir.join("incision.ron");
+    let o = incise(&[
+        "run",
+        SCENE,
+        "--frames",
+        "90",
+        "--record-stroke",
+        stroke.to_str().unwrap(),
+        "--out",
+        dir.join("recorded").to_str().unwrap(),
+        "--vtu-every",
+        "0",
+        "--device",
+        "cpu",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+
+    let out = dir.join("out");
+    let session = monado::run(
+        manifest,
+        &dir,
+        &[
+            "xr",
+            SCENE,
+            "--stroke",
+            stroke.to_str().unwrap(),
+            "--device",
+            "cpu",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        layers,
+    );
+    let err = text(&session.stderr);
+    assert_eq!(session.status.code(), Some(0), "{err}");
+    let r = monado::report(&out, &session);
+    assert_eq!(r["exit"], "Exited", "{r}");
+    assert!(states(&r).contains(&"Focused".to_string()), "{r}");
+    // The session ended when the stroke had been played: 1.5 s of 1/60 s frames.
+    let sim = r["sim_frames"].as_u64().unwrap();
+    assert!((90..=92).contains(&sim), "{sim} simulation frames: {r}");
+    let live = r["released_tets"].as_f64().unwrap();
+    assert!(live > 20.0, "the stroke cut through the runtime: {r}");
+    assert!(r["max_tool_force"].as_f64().unwrap() > 0.05, "{r}");
+    // Along the stroke: the blade entered at x = 1.5 cm and had reached about 4 cm,
+    // on the line y = 2 cm, from the top (z = 2 cm) down.
+    let b = &r["cut_box"];
+    let (lo, hi) = (&b[0], &b[1]);
+    let f = |v: &Value, i: usize| v[i].as_f64().unwrap();
+    assert!(f(lo, 0) > 0.010 && f(hi, 0) < 0.045, "x: {b}");
+    assert!(f(hi, 0) - f(lo, 0) > 0.010, "the cut runs along x: {b}");
+    assert!(f(lo, 1) > 0.014 && f(hi, 1) < 0.026, "y: {b}");
+    assert!(f(hi, 2) < 0.021 && f(lo, 2) > 0.010, "z: {b}");
+
+    // Vibration while the blade is in the tissue, one stop each time it left (and none on
+    // the frames it was out).
+    let pulses = r["haptic_pulses"].as_u64().unwrap();
+    let stops = r["haptic_stops"].as_u64().unwrap();
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    assert!(pulses > 0, "{r}");
+    assert!(stops >= 1, "{r}");
+    assert_eq!(stops, haptic_endings(&csv), "one stop per contact: {r}");
+    assert!(
+        stops < r["frames"].as_u64().unwrap() / 4,
+        "stops only when the blade leaves: {r}"
+    );
+
+    // The session's recording replays headless to the same cut (within 5 %).
+    let o = incise(&[
+        "run",
+        SCENE,
+        "--stroke",
+        out.join("stroke.ron").to_str().unwrap(),
+        "--frames",
+        &sim.to_string(),
+        "--out",
+        dir.join("replay").to_str().unwrap(),
+        "--vtu-every",
+        "0",
+        "--device",
+        "cpu",
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let replayed = released_in_summary(&text(&o.stdout));
+    assert!(
+        (replayed - live).abs() <= 0.05 * live,
+        "replay {replayed} vs session {live} tets"
+    );
+    assert_validation_clean(&session, &dir, layers);
+}
