@@ -190,6 +190,12 @@ pub enum Command {
         /// Add the intestine scaling series (≈140k, 550k, 1.1M tets).
         #[arg(long)]
         scaling: bool,
+        /// Scene of the `realtime` target.
+        #[arg(long, default_value = "config/intestine_pull.ron")]
+        scene: PathBuf,
+        /// CPU solver threads of the `realtime` target (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// Endurance run: cut a scalpel scene, reset, cut again for a wall-clock duration;
     /// fails (exit 1) if memory grows > 5 %, file descriptors leak or a cut differs.
@@ -327,6 +333,9 @@ pub enum BenchTarget {
     Solver,
     /// The renderer alone, offscreen.
     Render,
+    /// The default scene at its own substeps: ms per frame split into substeps, release
+    /// checks and stress; frames per second (`--scene` for another scene).
+    Realtime,
 }
 
 /// Benchmark case selection.

@@ -2,6 +2,7 @@
 //! The binary in `main.rs` is a thin CLI over these modules; `tests/` drives both.
 
 pub mod bench;
+pub mod bench_realtime;
 pub mod bench_render;
 pub mod body;
 pub mod cli;

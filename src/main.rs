@@ -7,7 +7,7 @@ use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
 use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
 use incise::screenshots::ImageSize;
-use incise::{bench, bench_render, compare, exercise, experiment, mesh_cmd, screenshots};
+use incise::{bench, bench_realtime, bench_render, compare, exercise, experiment, mesh_cmd, screenshots};
 
 /// The scene opened when none is named.
 const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
@@ -164,12 +164,22 @@ fn main() -> ExitCode {
             ..
         } => bench_render::run(frames, json),
         Command::Bench {
+            target: BenchTarget::Realtime,
+            json,
+            frames,
+            device,
+            scene,
+            threads,
+            ..
+        } => bench_realtime::run(&scene, device, threads, frames, json),
+        Command::Bench {
             target: BenchTarget::Solver,
             json,
             frames,
             case,
             device,
             scaling,
+            ..
         } => bench::run(case, frames, json, device, scaling),
         Command::Soak {
             scene,

@@ -142,3 +142,66 @@ fn gpu_matches_cpu_on_a_scalpel_incision() {
         "the blade never cut, so release parity was not tested"
     );
 }
+
+/// A frame rolled back on the device takes back the tets its release checks switched off:
+/// the device's per-tet live flags equal the host's cut state after the rollback, and the
+/// next frames release the same tets as the CPU after its own rollback.
+#[test]
+fn gpu_rollback_restores_the_live_flags() {
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
+    let mut cpu = common::tearing_bar(1);
+    let mut gpu = GpuSolver::new(common::tearing_bar(1), &ctx).expect("upload");
+    // Step until a frame tears, so the next frame's checks switch off more tets mid-frame.
+    let mut frame = 0;
+    while cpu.cut().released_count() == 0 {
+        cpu.step_frame().unwrap();
+        gpu.step_frame().unwrap();
+        frame += 1;
+        assert!(frame < 60, "the bar never tore");
+    }
+    let node = (0..cpu.positions().len())
+        .find(|&i| cpu.node_kinds()[i] == incise_sim::xpbd::NodeKind::Free)
+        .unwrap();
+    cpu.inject_non_finite(node);
+    gpu.inject_non_finite(node);
+    assert!(cpu.step_frame().is_err() && gpu.step_frame().is_err());
+    let device_live = read_u32(&ctx, gpu.live_buffer());
+    let host = gpu.host();
+    for (slot, &t) in host_tet_of_slot(host).iter().enumerate() {
+        assert_eq!(
+            device_live[slot] != 0,
+            host.cut().is_live(t as usize),
+            "tet {t}: device live flag disagrees with the cut state after the rollback"
+        );
+    }
+    assert_eq!(cpu.cut().live(), gpu.host().cut().live());
+}
+
+/// Mesh tet of each colour-ordered slot (the order the device keeps per-tet data in).
+fn host_tet_of_slot(s: &incise_sim::Solver) -> Vec<u32> {
+    let colors = incise_sim::xpbd::greedy_tet_colors(s.mesh().node_count(), &s.mesh().tets).0;
+    let mut order: Vec<u32> = (0..s.mesh().tet_count() as u32).collect();
+    order.sort_by_key(|&t| (colors[t as usize], t));
+    order
+}
+
+/// Read a `u32` storage buffer back from the device.
+fn read_u32(ctx: &incise_sim::gpu::GpuContext, buf: &wgpu::Buffer) -> Vec<u32> {
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test readback"),
+        size: buf.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(buf, 0, &staging, 0, buf.size());
+    ctx.queue.submit([enc.finish()]);
+    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("poll");
+    let data = staging.slice(..).get_mapped_range().expect("mapped");
+    bytemuck::cast_slice(&data).to_vec()
+}

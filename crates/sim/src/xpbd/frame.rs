@@ -30,8 +30,12 @@ pub struct FrameStats {
     pub tool_force: Vec3,
     /// Nodes the tool pushed during the frame.
     pub contact_nodes: usize,
-    /// Wall time of the substeps (prediction, projection, velocity update), ms.
+    /// Wall time of the substeps (prediction, projection, velocity update, and the release
+    /// checks that fall in them), ms.
     pub solve_ms: f64,
+    /// Of `solve_ms`, the release checks (stress and release) inside the substeps, ms (CPU;
+    /// on the GPU they run in the same submission and are not timed apart: 0).
+    pub check_ms: f64,
     /// Wall time of stress, guards and release, ms.
     pub stress_ms: f64,
 }

@@ -88,6 +88,8 @@ pub struct Solver {
     pub(crate) contact_push: Vec<Vec3>,
     pub(crate) frame: u64,
     pub(crate) time: f64,
+    /// Wall time of the release checks inside the last frame's substeps, ms.
+    pub(crate) check_ms: f64,
     pub(crate) pool: Option<rayon::ThreadPool>,
 }
 
@@ -176,6 +178,7 @@ impl Solver {
             contact_push: vec![Vec3::ZERO; n],
             frame: 0,
             time: 0.0,
+            check_ms: 0.0,
             pool,
             lame,
             params,
@@ -411,6 +414,7 @@ impl Solver {
         }
         let mut stats = self.stats(released);
         stats.solve_ms = (t1 - t0).as_secs_f64() * 1e3;
+        stats.check_ms = self.check_ms;
         stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
         self.frame += 1;
         Ok(stats)
@@ -448,6 +452,7 @@ impl Solver {
         let checks = release_checks(self.time, h, n, self.params.release_interval);
         let mut next = checks.iter().peekable();
         let mut fresh = false;
+        self.check_ms = 0.0;
         for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
@@ -458,8 +463,10 @@ impl Solver {
             self.update_velocities(h);
             fresh = false;
             if next.next_if(|&&k| k == s).is_some() {
+                let t0 = Instant::now();
                 self.compute_stress(parallel);
                 self.switch_off_overstressed();
+                self.check_ms += t0.elapsed().as_secs_f64() * 1e3;
                 fresh = true;
             }
         }
@@ -747,6 +754,7 @@ impl Solver {
                 .filter(|p| **p != Vec3::ZERO)
                 .count(),
             solve_ms: 0.0,
+            check_ms: 0.0,
             stress_ms: 0.0,
         }
     }

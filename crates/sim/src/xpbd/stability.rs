@@ -13,7 +13,10 @@
 //! one. Measured on a 6×3×2 block at ν = 0.3/0.45/0.49: κ ≤ 0.92 stays at rest to 1e-9 m
 //! over 300 frames, κ ≥ 1.6 drifts by 1e-4 m to centimetres (see docs/physics-notes.md).
 //! The solver refuses settings above [`MAX_STIFFNESS_NUMBER`] and says how many substeps
-//! would do.
+//! would do. The bound holds for the rest-free pair too: it has no tension at rest, but a
+//! loaded tissue carries stress of the same order, and one Gauss–Seidel sweep per substep
+//! is accurate only for κ ≲ 1 (a cantilever sags 2× too far at κ = 11 and explodes at
+//! κ = 126; docs/physics-notes.md).
 
 use glam::Vec3;
 

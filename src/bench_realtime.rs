@@ -1,0 +1,124 @@
+//! `incise bench realtime`: the default scene (config/intestine_pull.ron) at its own
+//! substeps, as a trainee would run it — per-frame wall ms (median, p99) split into the
+//! substeps, the release checks inside them, and the end-of-frame stress, guards and
+//! release; frames per second; on the CPU or the GPU (issue 17, item 6).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+
+use crate::body::{Body, DeviceChoice};
+
+/// The realtime figures of one device.
+#[derive(Debug, Clone, Serialize)]
+pub struct RealtimeResult {
+    /// Scene file.
+    pub scene: String,
+    /// "cpu (N threads)" or the GPU adapter.
+    pub device: String,
+    /// Tets.
+    pub tets: usize,
+    /// Substeps per frame (the scene's).
+    pub substeps: u32,
+    /// Frame length, s.
+    pub frame_dt: f32,
+    /// Frames timed (after 2 warm-up frames).
+    pub frames: usize,
+    /// Median wall ms per frame.
+    pub frame_ms_median: f64,
+    /// 99th-percentile wall ms per frame.
+    pub frame_ms_p99: f64,
+    /// Median ms of the substeps (prediction, projection, contact, velocities).
+    pub substeps_ms_median: f64,
+    /// Median ms of the release checks inside the substeps (stress + release).
+    pub release_checks_ms_median: f64,
+    /// Median ms of the end-of-frame stress, guards and release hand-over.
+    pub stress_ms_median: f64,
+    /// Frames per second of wall time at the median frame.
+    pub frames_per_second: f64,
+    /// Whether the median frame fits the scene's frame length in wall time.
+    pub real_time: bool,
+}
+
+/// Time `frames` frames of `scene` on `device` and print a table row or the JSON.
+pub fn run(scene: &Path, device: DeviceChoice, threads: Option<usize>, frames: u32, json: bool) -> Result<()> {
+    let r = measure(scene, device, threads, frames)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        println!(
+            "{} on {}: {} tets, {} substeps/frame: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
+             substeps {:.1} ms, release checks {:.1} ms, stress+guards {:.1} ms{}",
+            r.scene,
+            r.device,
+            r.tets,
+            r.substeps,
+            r.frame_ms_median,
+            r.frame_ms_p99,
+            r.frames_per_second,
+            r.substeps_ms_median,
+            r.release_checks_ms_median,
+            r.stress_ms_median,
+            if r.real_time { " (real time)" } else { "" }
+        );
+    }
+    Ok(())
+}
+
+/// The measurement behind [`run`].
+pub fn measure(scene_path: &Path, device: DeviceChoice, threads: Option<usize>, frames: u32) -> Result<RealtimeResult> {
+    let scene = crate::scene::load_scene(scene_path)?;
+    let built = crate::scene::build_scene(&scene, scene_path, threads)?;
+    let (tets, substeps, frame_dt) = (
+        built.solver.mesh().tet_count(),
+        built.solver.params().substeps,
+        built.solver.params().frame_dt,
+    );
+    let stroke = built.tool.as_ref().and_then(|t| t.stroke.clone());
+    let mut body = Body::place(built.solver, device, |m| eprintln!("note: {m}"))
+        .with_context(|| format!("{}: placing the body", scene_path.display()))?;
+    let (mut frame, mut solve, mut checks, mut stress) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for f in 0..frames.max(1) as u64 + 2 {
+        if let Some(s) = &stroke {
+            body.move_tool(s.pose_at((f + 1) as f64 * frame_dt as f64));
+        }
+        let t = Instant::now();
+        let st = body
+            .step_frame()
+            .with_context(|| format!("{}: frame {f}", scene_path.display()))?;
+        if f >= 2 {
+            frame.push(t.elapsed().as_secs_f64() * 1e3);
+            solve.push(st.solve_ms - st.check_ms);
+            checks.push(st.check_ms);
+            stress.push(st.stress_ms);
+        }
+    }
+    let median = |v: &mut Vec<f64>| quantile(v, 0.5);
+    let frame_ms_median = median(&mut frame.clone());
+    Ok(RealtimeResult {
+        scene: scene_path.display().to_string(),
+        device: body.device(),
+        tets,
+        substeps,
+        frame_dt,
+        frames: frame.len(),
+        frame_ms_median,
+        frame_ms_p99: quantile(&mut frame, 0.99),
+        substeps_ms_median: median(&mut solve),
+        release_checks_ms_median: median(&mut checks),
+        stress_ms_median: median(&mut stress),
+        frames_per_second: 1e3 / frame_ms_median,
+        real_time: frame_ms_median <= frame_dt as f64 * 1e3,
+    })
+}
+
+/// The `q` quantile (nearest rank) of `v`.
+fn quantile(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * q).round() as usize]
+}
