@@ -29,7 +29,7 @@ fn block_model(law: StiffnessLaw) -> MassSpringModel {
     let ends: Vec<u32> = (0..m.node_count() as u32)
         .filter(|&i| {
             let x = m.positions()[i as usize].x;
-            x < 1e-6 || x > SIZE[0] - 1e-6
+            !(1e-6..=SIZE[0] - 1e-6).contains(&x)
         })
         .collect();
     m.fix(&ends, AxisMask::ALL).unwrap();

@@ -409,7 +409,7 @@ impl MassSpringModel {
                 pairs.push((w, t, self.tet_k[t as usize][e]));
             }
         }
-        pairs.sort_unstable_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+        pairs.sort_unstable_by_key(|a| (a.0, a.1));
         let (tension, law, k) = (
             self.params.tension,
             self.params.stiffness_law,

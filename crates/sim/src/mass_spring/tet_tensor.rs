@@ -126,10 +126,11 @@ fn solve6(mut g: [[f64; 6]; 6], mut b: [f64; 6]) -> Option<[f64; 6]> {
         }
         g.swap(c, p);
         b.swap(c, p);
+        let pivot = g[c];
         for r in c + 1..6 {
-            let f = g[r][c] / g[c][c];
-            for k in c..6 {
-                g[r][k] -= f * g[c][k];
+            let f = g[r][c] / pivot[c];
+            for (x, p) in g[r].iter_mut().zip(pivot).skip(c) {
+                *x -= f * p;
             }
             b[r] -= f * b[c];
         }
