@@ -289,3 +289,34 @@ fn fixed_level_localisation_keeps_its_level() {
     }
     assert!(report["localisation"].get("budget_ms").is_none());
 }
+
+/// `incise experiment nakao-chest` prints the paper's chest tables beside ours and writes
+/// its files.
+#[test]
+fn chest_experiment_prints_the_papers_tables_beside_ours() {
+    let out = temp_dir("nakao_chest");
+    let o = incise(&[
+        "experiment",
+        "nakao-chest",
+        "--loops",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let table = text(&o.stdout);
+    for row in [
+        "| paper (MRI chest wall + heart) | 17582 | 100807 | 19964 | 73279 |",
+        "| ours, before the incision | 17582 |",
+        "| level 4 | 219–232 |",
+        "| level 6 | 346–480 |",
+        "| manager, 5.6 ms | 292–471 |",
+        "load average",
+    ] {
+        assert!(table.contains(row), "no {row:?} in\n{table}");
+    }
+    let csv = std::fs::read_to_string(out.join("loops.csv")).unwrap();
+    // A header and 20 loops per case.
+    assert_eq!(csv.lines().count(), 1 + 3 * 20, "{csv}");
+    assert!(out.join("table.md").exists() && out.join("results.json").exists());
+}

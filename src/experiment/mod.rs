@@ -2,4 +2,5 @@
 
 pub mod nakao;
 pub mod nakao_bench;
+pub mod nakao_chest;
 pub mod rheology;
