@@ -36,8 +36,8 @@ struct Run {
     model: MassSpringModel,
 }
 
-/// Run every case, write `table.md`, `table.csv`, `results.json` and the PNG figures
-/// into `opts.out`; returns the markdown table.
+/// Run every case, write `table.md`, `table.csv`, `results.json`, the PNG figures and the
+/// added-counts comparison into `opts.out`; returns the markdown tables.
 pub fn run(opts: &NakaoOptions) -> Result<String> {
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("cannot create {}", opts.out.display()))?;
@@ -63,7 +63,14 @@ pub fn run(opts: &NakaoOptions) -> Result<String> {
                 .with_context(|| format!("plate cut at tension {}", s.tension))
         })
         .collect::<Result<_>>()?;
-    let table = markdown(&runs);
+    let prov = super::nakao_chest::provenance();
+    let table = format!(
+        "Measured on {}, {}, load average {}.\n\n{}",
+        prov.machine,
+        prov.date_utc,
+        prov.load_average,
+        markdown(&runs)
+    );
     write(&opts.out.join("table.md"), &table)?;
     write(&opts.out.join("table.csv"), &csv(&runs)?)?;
     let results: Vec<&PlateCutResult> = runs.iter().map(|r| &r.result).collect();
@@ -73,7 +80,8 @@ pub fn run(opts: &NakaoOptions) -> Result<String> {
     )?;
     charts(&opts.out, &runs)?;
     wounds(&opts.out, &runs)?;
-    Ok(table)
+    let counts = super::nakao_counts::run(&opts.out)?;
+    Ok(format!("{table}\n{counts}"))
 }
 
 fn write(path: &Path, text: &str) -> Result<()> {

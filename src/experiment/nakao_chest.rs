@@ -69,13 +69,17 @@ struct CaseRun {
 
 /// Where and when the figures were measured.
 #[derive(Debug, Clone, Serialize)]
-struct Provenance {
-    machine: String,
-    date_utc: String,
-    load_average: String,
+pub(crate) struct Provenance {
+    /// CPU and cores.
+    pub machine: String,
+    /// When, UTC.
+    pub date_utc: String,
+    /// 1, 5 and 15 minute load averages.
+    pub load_average: String,
 }
 
-fn provenance() -> Provenance {
+/// This machine, now, and its load.
+pub(crate) fn provenance() -> Provenance {
     let date = std::process::Command::new("date")
         .args(["-u", "+%Y-%m-%d %H:%M UTC"])
         .output()
