@@ -99,20 +99,20 @@ fn markdown(runs: &[Run]) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "| subdivision | tension | nodes | edges | triangles | tets | cut area (cm²) | opening at middle (mm) | max loop (ms) | max cut (ms) | worst dihedral (°) |"
+        "| subdivision | tension | nodes | edges | triangles | tets | cut area (cm²) | opening at middle (mm) | max loop (ms) | max cut (ms) | worst dihedral (°) | worst radius ratio of new tets |"
     );
-    let _ = writeln!(t, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(t, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     let [n0, e0, f0, t0] = PAPER_BEFORE;
     let [n1, e1, f1, t1] = PAPER_AFTER;
     let _ = writeln!(
         t,
-        "| paper (Nakao 2003) | 2–6 % | {n0} → {n1} | {e0} → {e1} | {f0} → {f1} | {t0} → {t1} | (Fig. 12) | (Fig. 11) | – | – | – |"
+        "| paper (Nakao 2003) | 2–6 % | {n0} → {n1} | {e0} → {e1} | {f0} → {f1} | {t0} → {t1} | (Fig. 12) | (Fig. 11) | – | – | – | – |"
     );
     for r in runs {
         let (b, a, x) = (&r.result.before, &r.result.after, &r.result);
         let _ = writeln!(
             t,
-            "| {} | {:.0} % | {} → {} | {} → {} | {} → {} | {} → {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} |",
+            "| {} | {:.0} % | {} → {} | {} → {} | {} → {} | {} → {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} | {:.3} |",
             label(x.setup.cut.subdivision),
             x.setup.tension * 100.0,
             b.nodes,
@@ -128,12 +128,14 @@ fn markdown(runs: &[Run]) -> String {
             x.max_loop_ms,
             x.max_cut_ms,
             x.worst_dihedral_deg,
+            x.worst_new_radius_ratio,
         );
     }
     let _ = writeln!(
         t,
         "\nMax loop = the slowest 10 ms visual loop while cutting (one blade advance + 10 ms of \
-         simulation of the whole plate); max cut = the slowest blade advance alone. Loop times \
+         simulation of the whole plate); max cut = the slowest blade advance alone; radius ratio = \
+         3 r_in / R_circ (1 for a regular tet). Loop times \
          depend on the machine and on other load; the counts, areas and openings do not. The \
          paper gives no loop times for the plate (its 2.0–13.7 ms are the chest's: \
          `incise experiment nakao-chest`)."

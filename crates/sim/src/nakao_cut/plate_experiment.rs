@@ -7,7 +7,7 @@ use std::time::Instant;
 use glam::DVec3;
 use serde::Serialize;
 
-use super::measure::{MeshCounts, counts, cut_surface_area, opening_width};
+use super::measure::{MeshCounts, counts, cut_surface_area, opening_width, worst_new_tet_quality};
 use super::{BladePose, CutParams, Cutter, Subdivision};
 use crate::generate::plate;
 use crate::mass_spring::{AxisMask, MassSpringError, MassSpringModel, MassSpringParams, Tension};
@@ -85,6 +85,9 @@ pub struct PlateCutResult {
     pub max_cut_ms: f64,
     /// Smallest dihedral angle of the tets the cut created, degrees.
     pub worst_dihedral_deg: f64,
+    /// Smallest aspect-ratio quality (radius ratio `3 r_in / R_circ`, 1 = regular) of the
+    /// tets holding a node the cut created.
+    pub worst_new_radius_ratio: f64,
     /// Kinetic energy at the end, J (how settled the wound is).
     pub final_kinetic_energy: f64,
     /// Edges split at a crossing, over the whole cut.
@@ -168,6 +171,7 @@ pub fn run_plate_cut(
         max_loop_ms,
         max_cut_ms,
         worst_dihedral_deg: worst,
+        worst_new_radius_ratio: worst_new_tet_quality(&model, before.nodes).unwrap_or(1.0),
         final_kinetic_energy: model.kinetic_energy(),
         split_edges,
         duplicated_nodes,
