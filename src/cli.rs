@@ -276,6 +276,18 @@ pub enum ExperimentCommand {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Nakao 2003 chest (PHYSICS.md §2.6, Figs. 15–17): an incision along the sternum of a
+    /// torso-like chest (the paper's 17,582 nodes) at levels 4, 6 and with the refresh-rate
+    /// manager at 5.6 ms; prints the paper's tables beside ours, writes table.md,
+    /// loops.csv and results.json.
+    NakaoChest {
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// 10 ms loops per case (at least 20).
+        #[arg(long, default_value_t = 120)]
+        loops: usize,
+    },
     /// Loop times of the mass-spring cutter on a chest-scale slab (18.5k nodes, 72k tets):
     /// levels 4 and 6, the whole mesh, the refresh-rate manager and the blade advances.
     NakaoBench {

@@ -10,6 +10,8 @@ pub mod compare;
 pub mod exercise;
 pub mod experiment;
 pub mod interrupt;
+pub mod loop_report;
+mod mass_spring_frames;
 pub mod mesh_cmd;
 pub mod plot;
 pub mod preview;

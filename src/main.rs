@@ -256,6 +256,13 @@ fn main() -> ExitCode {
                 experiment::nakao::run(&experiment::nakao::NakaoOptions { out })
                     .map(|table| print!("{table}"))
             }
+            ExperimentCommand::NakaoChest { out, loops } => {
+                experiment::nakao_chest::run(&experiment::nakao_chest::NakaoChestOptions {
+                    out,
+                    loops,
+                })
+                .map(|table| print!("{table}"))
+            }
             ExperimentCommand::NakaoBench {
                 loops,
                 budget_ms,

@@ -82,6 +82,24 @@ pub struct EdgeFrameStats {
     /// Haptic loops run so far; haptic-rate runs only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub haptic_loops: Option<u64>,
+    /// Localisation level the frame reached; localised mass-spring runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub level: Option<u32>,
+    /// Nodes integrated in the frame; mass-spring runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub free_nodes: Option<usize>,
+    /// The frame's localisation (nearest node, hierarchy), ms; mass-spring runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub localise_ms: Option<f64>,
+    /// The frame's spring-force computation, ms; mass-spring runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub force_ms: Option<f64>,
+    /// The frame's velocity and position updates, ms; mass-spring runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integrate_ms: Option<f64>,
+    /// The frame's blade advance (crossings, subdivision, remodelling), ms; mass-spring runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cut_ms: Option<f64>,
     /// Depth of the indenter face below the rest top, m; rheology scenes with an indenter.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub indenter_depth: Option<f64>,
@@ -132,6 +150,9 @@ pub struct Report {
     /// Loop rate and tool force of a haptic-rate run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub haptic: Option<HapticInfo>,
+    /// Levels, free nodes and loop-time split over the frames of a mass-spring run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub localisation: Option<crate::loop_report::LocalisationInfo>,
 }
 
 /// Mesh figures for the report.
@@ -262,6 +283,15 @@ impl Report {
                         r.max_dent_m * 1e3,
                         r.residual_dent_m * 1e3
                     );
+                }
+                if let Some(l) = &self.localisation {
+                    line += &format!(
+                        ", localisation {}: {:.0}–{:.0} nodes, loop {:.2}–{:.2} ms",
+                        l.mode, l.free_nodes.min, l.free_nodes.max, l.total_ms.min, l.total_ms.max
+                    );
+                    if let Some(level) = &l.level {
+                        line += &format!(", level {:.0}–{:.0}", level.min, level.max);
+                    }
                 }
                 if let Some(h) = &self.haptic {
                     line += &format!(

@@ -203,6 +203,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         snapshots: Vec::new(),
         rheology: None,
         haptic: None,
+        localisation: None,
     };
     let report_path = opts.out.join("report.json");
     let mut pvd: Vec<(f64, String)> = Vec::new();

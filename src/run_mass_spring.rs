@@ -18,15 +18,17 @@ use incise_sim::io::{VtuFrame, write_pvd, write_vtu};
 use incise_sim::mass_spring::{
     AxisMask, HapticConfig, HapticLoop, LocalLoopParams, MassSpringModel, MassSpringParams,
 };
+use incise_sim::nakao_cut::BladePose;
 use incise_sim::nakao_cut::measure::counts;
-use incise_sim::nakao_cut::{BladePose, Cutter};
 use incise_sim::{Material, TetMesh};
 
 use crate::report::{
     EdgeFrameStats, FrameData, FrameRecord, HapticInfo, MaterialInfo, MeshInfo, Report,
 };
 use crate::run::{RunEnd, RunOptions, RunOutcome};
-use crate::scene::{MassSpringScene, MaterialChoice, Scene, StrokeSpec, load_materials, raw_mesh};
+use crate::scene::{
+    Localisation, MassSpringScene, MaterialChoice, Scene, StrokeSpec, load_materials, raw_mesh,
+};
 
 /// Run the mass-spring scene `scene` (with model settings `ms`) as `opts` asks.
 pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<RunOutcome> {
@@ -37,6 +39,7 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
     let (material, material_name) = material(scene, dir, &opts.scene)?;
     let params = MassSpringParams {
         stiffness: ms.stiffness,
+        stiffness_law: ms.stiffness_law,
         damping: ms.damping,
         density: material.density as f64,
         gravity: scene.solver.gravity.as_dvec3(),
@@ -105,6 +108,7 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
         snapshots: Vec::new(),
         rheology: None,
         haptic: None,
+        localisation: None,
     };
     let total_volume: f64 = (0..model.tet_count())
         .map(|t| model.reference_volume(t))
@@ -127,7 +131,7 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
             report.haptic = Some(haptic);
             model
         }
-        None => run_frames(
+        None => crate::mass_spring_frames::run_frames(
             model,
             ms,
             frame_dt,
@@ -160,66 +164,6 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
     crate::run::finish(report, opts.out.join("report.json"), stopped, opts)
 }
 
-/// The ordinary run: cut along the stroke and step the model frame by frame; returns it.
-#[allow(clippy::too_many_arguments)]
-fn run_frames(
-    mut model: MassSpringModel,
-    ms: &MassSpringScene,
-    frame_dt: f64,
-    frames: u64,
-    total_volume: f64,
-    opts: &RunOptions,
-    report: &mut Report,
-    pvd: &mut Vec<(f64, String)>,
-) -> Result<MassSpringModel> {
-    let mut cutter = Cutter::new(ms.cut.clone());
-    let mut cutting = false;
-    for f in 0..frames {
-        if crate::interrupt::requested() {
-            break;
-        }
-        let t0 = Instant::now();
-        if let Some(stroke) = &ms.stroke {
-            let (pose, progress) = blade_at(stroke, model.time());
-            if progress > 0.0 && !cutting && progress < 1.0 {
-                cutter.begin(&model, blade_at(stroke, stroke.start as f64).0);
-                cutting = true;
-            }
-            if cutting {
-                cutter.advance(&mut model, pose);
-                if progress >= 1.0 {
-                    cutter.end();
-                    cutting = false;
-                }
-            }
-        }
-        let steps = model.advance(frame_dt);
-        let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
-        let volume: f64 = (0..model.tet_count())
-            .map(|t| model.current_volume(t))
-            .sum();
-        report.frames.push(FrameRecord {
-            haptic_amplitude: None,
-            stats: FrameData::Edges(EdgeFrameStats {
-                frame: f,
-                sim_time: model.time(),
-                substeps: steps as u64,
-                volume_ratio: volume / total_volume,
-                max_displacement: max_displacement(model.reference_positions(), model.positions()),
-                kinetic_energy: Some(model.kinetic_energy()),
-                solve_ms: Some(wall_ms),
-                ..EdgeFrameStats::default()
-            }),
-            wall_ms,
-            gpu_ms: None,
-        });
-        if opts.vtu_every > 0 && (f + 1) % opts.vtu_every == 0 {
-            snapshot(&opts.out, &model, f + 1, pvd)?;
-        }
-    }
-    Ok(model)
-}
-
 /// The haptic-rate run: the local loop on its own thread at `rate` Hz with its tool at
 /// the middle of the blade edge, cutting along the stroke; this thread wakes every
 /// `frame_dt` of wall time for `frames` frames, moves the tool and the blade to where the
@@ -238,7 +182,7 @@ fn run_haptic(
     let config = HapticConfig {
         rate_hz: rate,
         publish_hz: 1.0 / frame_dt,
-        local: LocalLoopParams::default(),
+        local: haptic_localisation(ms.localisation),
         cut: ms.cut.clone(),
         ..HapticConfig::default()
     };
@@ -319,8 +263,25 @@ fn run_haptic(
     Ok((model, info))
 }
 
+/// The haptic loop's localisation: the scene's level or budget; `Whole` keeps the loop's
+/// default level 4 (a 1 kHz loop cannot integrate a large mesh whole).
+fn haptic_localisation(l: Localisation) -> LocalLoopParams {
+    match l {
+        Localisation::Whole => LocalLoopParams::default(),
+        Localisation::Level(d) => LocalLoopParams {
+            max_level: d,
+            ..LocalLoopParams::default()
+        },
+        Localisation::Budget(ms) => LocalLoopParams {
+            budget_ms: Some(ms),
+            max_level: u32::MAX,
+            ..LocalLoopParams::default()
+        },
+    }
+}
+
 /// Largest distance of a node from its reference position, m.
-fn max_displacement(reference: &[DVec3], x: &[DVec3]) -> f64 {
+pub(crate) fn max_displacement(reference: &[DVec3], x: &[DVec3]) -> f64 {
     reference
         .iter()
         .zip(x)
@@ -349,7 +310,7 @@ fn material(scene: &Scene, dir: &Path, scene_path: &Path) -> Result<(Material, S
 }
 
 /// The blade pose at time `t` and the stroke's progress (0 before it starts, 1 at its end).
-fn blade_at(s: &StrokeSpec, t: f64) -> (BladePose, f64) {
+pub(crate) fn blade_at(s: &StrokeSpec, t: f64) -> (BladePose, f64) {
     let length = s.travel.length() as f64;
     let progress = if length > 0.0 {
         ((t - s.start as f64) * s.speed as f64 / length).clamp(0.0, 1.0)
@@ -367,7 +328,7 @@ fn blade_at(s: &StrokeSpec, t: f64) -> (BladePose, f64) {
 }
 
 /// Write `snap_NNNNN.vtu` (per node: velocity; per tet: cut faces) and list it.
-fn snapshot(
+pub(crate) fn snapshot(
     out: &Path,
     m: &MassSpringModel,
     frame: u64,

@@ -176,6 +176,7 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
             residual_dent_m: 0.0,
         }),
         haptic: None,
+        localisation: None,
     };
     let rest_volume: f64 = mesh.rest_volume.iter().map(|&v| v as f64).sum();
     let report_path = opts.out.join("report.json");
@@ -216,6 +217,7 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
                 haptic_loops: None,
                 indenter_depth: schedule.map(|s| s.depth_at(body.time()).0),
                 dent_depth: Some(dent),
+                ..EdgeFrameStats::default()
             }),
             wall_ms: t0.elapsed().as_secs_f64() * 1e3,
             gpu_ms: None,

@@ -2,4 +2,6 @@
 
 pub mod nakao;
 pub mod nakao_bench;
+pub mod nakao_chest;
+pub mod nakao_counts;
 pub mod rheology;

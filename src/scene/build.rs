@@ -200,6 +200,7 @@ pub fn raw_mesh(source: &MeshSource, dir: &Path) -> Result<(RawMesh, Option<TriS
         }
         MeshSource::Generate(g) => match g {
             Generator::Plate => (generate::plate(), None),
+            Generator::Chest => (generate::chest(), None),
             Generator::Intestine(p) => {
                 let problems = p.problems();
                 if !problems.is_empty() {

@@ -4,12 +4,14 @@
 mod build;
 pub mod hand_tool;
 mod load;
+mod localisation;
 mod model;
 mod tool;
 
 pub use build::raw_mesh;
 pub use build::{BuiltScene, SceneTool, ToolDriver, build_scene, build_scene_driven};
 pub use load::{SceneError, load_materials, load_scene, locate, parse_scene};
+pub use localisation::Localisation;
 pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
     StrokeSpec,
@@ -85,6 +87,8 @@ pub enum MeshSource {
 pub enum Generator {
     /// The Nakao 2003 plate, 16 × 16 × 0.4 cm.
     Plate,
+    /// The torso-like chest wall + heart of the Nakao chest experiment (17,582 nodes).
+    Chest,
     /// A curved thick-walled tube with a lumen; `()` for the ≈34k-tet default.
     Intestine(#[serde(default)] IntestineParams),
     /// A box from `min` with edge lengths `size`, split into `cells` hexes (6 tets each).

@@ -3,10 +3,12 @@
 //! body with a material per region (PHYSICS.md §3).
 
 use glam::{DVec2, Vec3};
-use incise_sim::mass_spring::Tension;
+use incise_sim::mass_spring::{StiffnessLaw, Tension};
 use incise_sim::nakao_cut::CutParams;
 use incise_sim::selection::NodeSelection;
 use serde::Deserialize;
+
+use super::Localisation;
 
 /// The simulation model of a scene.
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -153,6 +155,10 @@ pub struct MassSpringScene {
     /// Spring constant k of every edge, N/m.
     #[serde(default = "default_stiffness")]
     pub stiffness: f64,
+    /// How each edge's constant follows from `stiffness`: `TetVolume` (default: from the
+    /// tets' volumes, so a cut region keeps its stiffness) or the paper's `Uniform`.
+    #[serde(default)]
+    pub stiffness_law: StiffnessLaw,
     /// Node damping b, N·s/m.
     #[serde(default = "default_damping")]
     pub damping: f64,
@@ -168,6 +174,10 @@ pub struct MassSpringScene {
     /// Cutter settings (`subdivision: Adaptive | NonAdaptive`, …).
     #[serde(default)]
     pub cut: CutParams,
+    /// Which nodes each frame integrates: `Whole` (default), `Level(d)` around the blade,
+    /// or `Budget(ms)`, the refresh-rate manager (PHYSICS.md §2.5).
+    #[serde(default)]
+    pub localisation: Localisation,
 }
 
 fn default_stiffness() -> f64 {
@@ -217,6 +227,7 @@ impl MassSpringScene {
     pub fn validate(&self) -> Result<(), (String, String)> {
         let params = incise_sim::mass_spring::MassSpringParams {
             stiffness: self.stiffness,
+            stiffness_law: self.stiffness_law,
             damping: self.damping,
             tension: self.tension,
             ..Default::default()
@@ -228,6 +239,15 @@ impl MassSpringScene {
         }
         if let Err((field, msg)) = self.cut.validate() {
             return Err((format!("model.cut.{field}"), msg));
+        }
+        if let Err(msg) = self.localisation.validate() {
+            return Err(("model.localisation".into(), msg));
+        }
+        if self.localisation != Localisation::Whole && self.stroke.is_none() {
+            return Err((
+                "model.localisation".into(),
+                "localises around the blade, so the scene needs a model.stroke".into(),
+            ));
         }
         if let Some(s) = &self.stroke {
             if !(s.heel.is_finite() && s.tip.is_finite() && s.travel.is_finite()) {

@@ -14,25 +14,24 @@ use super::MassSpringModel;
 const STABILITY_SAFETY: f64 = 0.8;
 
 impl MassSpringModel {
-    /// Sum of the spring forces on node `i`: `Σ k (l − l0) u` over its springs.
+    /// Sum of the spring forces on node `i`: `Σ k_e (l − l0) u` over its springs.
     // PHYSICS.md §2.1, eq. 1 (F_spring).
     #[inline]
     pub fn spring_force(&self, i: usize) -> DVec3 {
-        let k = self.params.stiffness;
         let x = self.positions[i];
         let mut f = DVec3::ZERO;
         for s in &self.springs[i] {
             let d = self.positions[s.node as usize] - x;
             let l = d.length();
             if l > 0.0 {
-                f += d * (k * (l - s.rest) / l);
+                f += d * (s.stiffness * (l - s.rest) / l);
             }
         }
         f
     }
 
     /// The largest stable step for the springs, s: `0.8 · 2/ω_max` with
-    /// `ω_max² ≤ max_i Σ_j k (1/m_i + 1/√(m_i m_j))` (Gershgorin on `M^{-1/2} K M^{-1/2}`).
+    /// `ω_max² ≤ max_i Σ_j k_ij (1/m_i + 1/√(m_i m_j))` (Gershgorin on `M^{-1/2} K M^{-1/2}`).
     pub fn stable_dt(&self) -> f64 {
         self.stable_dt
     }
@@ -63,7 +62,6 @@ impl MassSpringModel {
 
     /// Gershgorin row bound of `ω²` at node `i` (0 for pinned or massless nodes).
     fn stiffness_row(&self, i: usize) -> f64 {
-        let k = self.params.stiffness;
         let mi = self.masses[i];
         if mi <= 0.0 || self.fixed[i].is_pinned() {
             return 0.0;
@@ -72,61 +70,85 @@ impl MassSpringModel {
             .iter()
             .map(|s| {
                 let mj = self.masses[s.node as usize];
-                k * (1.0 / mi
-                    + if mj > 0.0 {
-                        1.0 / (mi * mj).sqrt()
-                    } else {
-                        0.0
-                    })
+                s.stiffness
+                    * (1.0 / mi
+                        + if mj > 0.0 {
+                            1.0 / (mi * mj).sqrt()
+                        } else {
+                            0.0
+                        })
             })
             .sum()
     }
 
-    /// New velocity of node `i` after a step `dt` (eq. 2 with implicit node damping).
-    // PHYSICS.md §2.1, eqs. 1–2.
+    /// Total force on node `i`: its springs plus any external force, N.
+    // PHYSICS.md §2.1, eq. 1 (gravity enters as an acceleration in eq. 2).
     #[inline]
-    fn stepped_velocity(&self, i: usize, dt: f64) -> DVec3 {
-        let m = self.masses[i];
-        if m <= 0.0 {
-            return DVec3::ZERO;
-        }
+    fn node_force(&self, i: usize) -> DVec3 {
         let mut f = self.spring_force(i);
         for &(n, e) in &self.external {
             if n as usize == i {
                 f += e;
             }
         }
+        f
+    }
+
+    /// New velocity of node `i` under force `f` after a step `dt` (eq. 2 with implicit
+    /// node damping).
+    // PHYSICS.md §2.1, eqs. 1–2.
+    #[inline]
+    fn stepped_velocity(&self, i: usize, f: DVec3, dt: f64) -> DVec3 {
+        let m = self.masses[i];
+        if m <= 0.0 {
+            return DVec3::ZERO;
+        }
         let a = f / m + self.params.gravity;
         let v = (self.velocities[i] + dt * a) / (1.0 + dt * self.params.damping / m);
         self.fixed[i].free_part(v)
     }
 
+    /// The force phase of a step for `nodes`: their total forces into `out` (cleared).
+    pub fn gather_forces(&self, nodes: &[u32], out: &mut Vec<DVec3>) {
+        out.clear();
+        out.extend(nodes.iter().map(|&i| self.node_force(i as usize)));
+    }
+
+    /// The integration phase of a step of `dt` for `nodes` under `forces` (from
+    /// [`MassSpringModel::gather_forces`] for the same nodes); other nodes stay in place.
+    // PHYSICS.md §2.1, eq. 2.
+    pub fn integrate_nodes(&mut self, dt: f64, nodes: &[u32], forces: &[DVec3]) {
+        for (&i, &f) in nodes.iter().zip(forces) {
+            let i = i as usize;
+            let v = self.stepped_velocity(i, f, dt);
+            self.velocities[i] = v;
+            self.positions[i] += dt * v;
+        }
+        self.time += dt;
+    }
+
     /// One explicit step of `dt` for every node.
     pub fn step(&mut self, dt: f64) {
         let n = self.node_count();
-        let mut v_new = std::mem::take(&mut self.scratch);
-        v_new.clear();
-        v_new.extend((0..n).map(|i| self.stepped_velocity(i, dt)));
-        for (i, v) in v_new.iter().enumerate() {
-            self.velocities[i] = *v;
-            self.positions[i] += dt * *v;
+        let mut f = std::mem::take(&mut self.scratch);
+        f.clear();
+        f.extend((0..n).map(|i| self.node_force(i)));
+        for (i, f) in f.iter().enumerate() {
+            let v = self.stepped_velocity(i, *f, dt);
+            self.velocities[i] = v;
+            self.positions[i] += dt * v;
         }
-        self.scratch = v_new;
+        self.scratch = f;
         self.time += dt;
     }
 
     /// One explicit step of `dt` for `nodes` only; every other node is frozen in place
     /// (PHYSICS.md §2.5) and acts on them through its springs.
     pub fn step_nodes(&mut self, dt: f64, nodes: &[u32]) {
-        let mut v_new = std::mem::take(&mut self.scratch);
-        v_new.clear();
-        v_new.extend(nodes.iter().map(|&i| self.stepped_velocity(i as usize, dt)));
-        for (&i, v) in nodes.iter().zip(&v_new) {
-            self.velocities[i as usize] = *v;
-            self.positions[i as usize] += dt * *v;
-        }
-        self.scratch = v_new;
-        self.time += dt;
+        let mut f = std::mem::take(&mut self.scratch);
+        self.gather_forces(nodes, &mut f);
+        self.integrate_nodes(dt, nodes, &f);
+        self.scratch = f;
     }
 
     /// Simulate `duration` seconds in equal steps no larger than the stable step; returns

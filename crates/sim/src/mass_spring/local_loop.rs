@@ -1,6 +1,7 @@
 //! One localised simulation loop (PHYSICS.md §2.5): find the node nearest the tool, build
 //! the hierarchy to level d (or to the refresh-rate manager's node count), integrate the
-//! free nodes only, and feed the loop time back to the manager.
+//! free nodes only, and feed the time of the force computation back to the manager. Each
+//! phase is timed apart (localise, force, integrate), as the paper's Figs. 15–17 split it.
 
 use std::time::Instant;
 
@@ -65,10 +66,23 @@ pub struct LoopStats {
     pub root: u32,
     /// Free (integrated) nodes.
     pub free_nodes: usize,
-    /// Hierarchy levels built.
+    /// Hierarchy levels built (level 0 is the root; the last may be partial).
     pub levels: usize,
     /// Loop time (hierarchy + forces + integration), ms, by the loop's clock.
     pub ms: f64,
+    /// Nearest node, hierarchy and stopping the nodes that left the free set, ms.
+    pub localise_ms: f64,
+    /// Spring and external forces on the free nodes, summed over the steps, ms.
+    pub force_ms: f64,
+    /// Velocity and position updates of the free nodes, summed over the steps, ms.
+    pub integrate_ms: f64,
+}
+
+impl LoopStats {
+    /// The deepest level the loop reached: the localisation level chosen (0: the root only).
+    pub fn level(&self) -> u32 {
+        self.levels.saturating_sub(1) as u32
+    }
 }
 
 /// The localised loop with its hierarchy, optional refresh-rate manager and clock.
@@ -78,6 +92,7 @@ pub struct LocalLoop<C: Clock = SystemClock> {
     hierarchy: NodeHierarchy,
     manager: Option<RefreshRateManager>,
     previous: Vec<u32>,
+    forces: Vec<DVec3>,
     clock: C,
 }
 
@@ -97,6 +112,7 @@ impl<C: Clock> LocalLoop<C> {
             hierarchy: NodeHierarchy::new(),
             manager,
             previous: Vec::new(),
+            forces: Vec::new(),
             clock,
         }
     }
@@ -113,6 +129,20 @@ impl<C: Clock> LocalLoop<C> {
 
     /// One loop of `dt` with the tool at `tip`. Nodes that left the free set stop.
     pub fn step(&mut self, model: &mut MassSpringModel, tip: DVec3, dt: f64) -> LoopStats {
+        self.frame(model, tip, dt, 1)
+    }
+
+    /// One loop that localises once around `tip` and then takes `steps` steps of `dt` on
+    /// the free nodes (a visual frame of several explicit steps). The manager, when set,
+    /// sees the force + integration time (the paper's "time used for the mechanical
+    /// computation") and picks the next loop's free-node count, hence its level.
+    pub fn frame(
+        &mut self,
+        model: &mut MassSpringModel,
+        tip: DVec3,
+        dt: f64,
+        steps: u32,
+    ) -> LoopStats {
         let t0 = self.clock.now();
         let root = self.hierarchy.nearest_node(model, tip).unwrap_or(0);
         let (level, cap) = match &self.manager {
@@ -127,10 +157,20 @@ impl<C: Clock> LocalLoop<C> {
             .filter(|&v| !self.hierarchy.is_free(v))
             .collect();
         model.stop_nodes(&left);
-        model.step_nodes(dt, self.hierarchy.free_nodes());
+        let t1 = self.clock.now();
+        let (mut force_ms, mut integrate_ms) = (0.0, 0.0);
+        for _ in 0..steps.max(1) {
+            let a = self.clock.now();
+            model.gather_forces(self.hierarchy.free_nodes(), &mut self.forces);
+            let b = self.clock.now();
+            model.integrate_nodes(dt, self.hierarchy.free_nodes(), &self.forces);
+            let c = self.clock.now();
+            force_ms += (b - a) * 1e3;
+            integrate_ms += (c - b) * 1e3;
+        }
         let ms = (self.clock.now() - t0) * 1e3;
         if let Some(m) = &mut self.manager {
-            m.update(ms);
+            m.update(force_ms + integrate_ms);
         }
         self.previous.clear();
         self.previous.extend_from_slice(self.hierarchy.free_nodes());
@@ -139,6 +179,9 @@ impl<C: Clock> LocalLoop<C> {
             free_nodes: self.hierarchy.free_nodes().len(),
             levels: self.hierarchy.levels(),
             ms,
+            localise_ms: (t1 - t0) * 1e3,
+            force_ms,
+            integrate_ms,
         }
     }
 }

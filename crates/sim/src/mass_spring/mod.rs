@@ -13,7 +13,9 @@ mod local_loop;
 mod model;
 mod params;
 mod refresh;
+mod stiffness;
 mod tension;
+mod tet_tensor;
 
 pub use adjacency::{ElementIndex, Rows};
 pub use axes::AxisMask;
@@ -23,6 +25,10 @@ pub use local_loop::{Clock, LocalLoop, LocalLoopParams, LoopStats, SystemClock};
 pub use model::{MassSpringModel, Spring};
 pub use params::{MassSpringError, MassSpringParams};
 pub use refresh::RefreshRateManager;
+pub use stiffness::StiffnessLaw;
 pub use tension::Tension;
+pub use tet_tensor::TetTensor;
+
+pub(crate) use tet_tensor::edge_frames;
 
 pub(crate) use model::signed_volume;

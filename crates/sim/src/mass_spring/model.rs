@@ -8,16 +8,19 @@
 
 use glam::DVec3;
 
-use super::{AxisMask, MassSpringError, MassSpringParams};
-use crate::mesh::{EdgeList, TetMesh};
+use super::{AxisMask, MassSpringError, MassSpringParams, StiffnessLaw, TetTensor, edge_frames};
+use crate::mesh::{TET_EDGES, TetMesh};
 
-/// One end's view of a spring: the node at the other end and the rest length.
+/// One end's view of a spring: the node at the other end, the rest length and the
+/// spring constant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spring {
     /// Node at the other end.
     pub node: u32,
     /// Rest length `l0`, m.
     pub rest: f64,
+    /// Spring constant `k` of this edge, N/m ([`crate::mass_spring::StiffnessLaw`]).
+    pub stiffness: f64,
 }
 
 /// Nodes, tets and springs of the mass-spring model, and its dynamic state.
@@ -46,6 +49,13 @@ pub struct MassSpringModel {
     /// External forces on single nodes (a tool), N.
     pub(crate) external: Vec<(u32, DVec3)>,
     initial_mass: f64,
+    /// Scale `c` of the stiffness law, fixed on the uncut mesh.
+    stiffness_scale: f64,
+    /// Each tet's share of the constant of its six edges ([`TET_EDGES`] order), N/m
+    /// (`TetVolume` law; an edge's constant is the sum over its tets).
+    pub(crate) tet_k: Vec<[f64; 6]>,
+    /// The stiffness per unit volume each tet carries (kept through splits and moves).
+    pub(crate) tet_material: Vec<TetTensor>,
 }
 
 impl MassSpringModel {
@@ -63,20 +73,13 @@ impl MassSpringModel {
             }
             tet_mass.push(params.density * volume);
         }
-        let edges = EdgeList::of_mesh(mesh);
-        let mut springs = vec![Vec::new(); n];
-        for e in &edges.edges {
-            let (a, b) = (e[0] as usize, e[1] as usize);
-            let rest = params.tension.rest_length(reference[a], reference[b]);
-            springs[a].push(Spring { node: e[1], rest });
-            springs[b].push(Spring { node: e[0], rest });
-        }
         let mut node_tets = vec![Vec::new(); n];
         for (t, tet) in mesh.tets.iter().enumerate() {
             for &v in tet {
                 node_tets[v as usize].push(t as u32);
             }
         }
+        let (scale, tet_k, tet_material) = initial_stiffness(&params, &reference, &mesh.tets);
         let mut model = MassSpringModel {
             params,
             positions: reference.clone(),
@@ -87,7 +90,9 @@ impl MassSpringModel {
             tet_cut_faces: vec![0; mesh.tet_count()],
             tet_mass,
             node_tets,
-            springs,
+            springs: vec![Vec::new(); n],
+            tet_k,
+            tet_material,
             twins: Vec::new(),
             reference,
             time: 0.0,
@@ -95,8 +100,12 @@ impl MassSpringModel {
             scratch: Vec::new(),
             external: Vec::new(),
             initial_mass: 0.0,
+            stiffness_scale: scale,
         };
         let all: Vec<u32> = (0..n as u32).collect();
+        for v in 0..n as u32 {
+            model.springs[v as usize] = model.springs_from_tets(v);
+        }
         model.recompute_masses(&all);
         model.initial_mass = model.tet_mass.iter().sum();
         model.refresh_stability();
@@ -297,10 +306,19 @@ impl MassSpringModel {
         self.tets[t as usize] = tet;
     }
 
-    /// Append a tet carrying `mass` with cut-face flags `cut_faces`.
-    pub(crate) fn push_tet(&mut self, tet: [u32; 4], mass: f64, cut_faces: u8) -> u32 {
+    /// Append a tet carrying `mass` and the stiffness `material` (per unit volume) with
+    /// cut-face flags `cut_faces`; its spring shares are fitted at the next rebuild.
+    pub(crate) fn push_tet(
+        &mut self,
+        tet: [u32; 4],
+        mass: f64,
+        material: TetTensor,
+        cut_faces: u8,
+    ) -> u32 {
         let t = self.tets.len() as u32;
         self.tets.push(tet);
+        self.tet_k.push([0.0; 6]);
+        self.tet_material.push(material);
         self.tet_mass.push(mass);
         self.tet_cut_faces.push(cut_faces);
         for v in tet {
@@ -326,45 +344,153 @@ impl MassSpringModel {
         }
     }
 
-    /// Rebuild the springs of `affected` nodes from their tets (rest lengths from eq. 3),
-    /// and refresh the rest lengths that their unaffected neighbours store for them.
+    /// Rebuild the springs of `affected` nodes from their tets (rest lengths from eq. 3,
+    /// constants from the stiffness law), and refresh what their unaffected neighbours
+    /// store for them.
     ///
     /// A node whose tets did not change keeps its neighbour set, so only nodes whose tets
     /// changed, or that moved, need to be listed.
     pub(crate) fn rebuild_springs(&mut self, affected: &[u32]) {
+        if self.params.stiffness_law == StiffnessLaw::TetVolume {
+            let mut tets: Vec<u32> = affected
+                .iter()
+                .flat_map(|&v| self.node_tets[v as usize].iter().copied())
+                .collect();
+            tets.sort_unstable();
+            tets.dedup();
+            for t in tets {
+                self.refit_tet(t as usize);
+            }
+        }
         let mut is_affected = vec![false; self.node_count()];
         for &v in affected {
             is_affected[v as usize] = true;
         }
-        let tension = self.params.tension;
         for &v in affected {
             let vi = v as usize;
-            let mut nbrs: Vec<u32> = self.node_tets[vi]
-                .iter()
-                .flat_map(|&t| self.tets[t as usize])
-                .filter(|&w| w != v)
-                .collect();
-            nbrs.sort_unstable();
-            nbrs.dedup();
-            let x = self.reference[vi];
-            self.springs[vi] = nbrs
-                .iter()
-                .map(|&w| Spring {
-                    node: w,
-                    rest: tension.rest_length(x, self.reference[w as usize]),
-                })
-                .collect();
-            for &w in &nbrs {
-                if is_affected[w as usize] {
+            self.springs[vi] = self.springs_from_tets(v);
+            for k in 0..self.springs[vi].len() {
+                let s = self.springs[vi][k];
+                if is_affected[s.node as usize] {
                     continue;
                 }
-                let rest = tension.rest_length(self.reference[w as usize], x);
-                if let Some(s) = self.springs[w as usize].iter_mut().find(|s| s.node == v) {
-                    s.rest = rest;
+                if let Some(back) = self.springs[s.node as usize]
+                    .iter_mut()
+                    .find(|b| b.node == v)
+                {
+                    back.rest = s.rest;
+                    back.stiffness = s.stiffness;
                 }
             }
         }
     }
+
+    /// Refit tet `t`'s spring shares to its stiffness per unit volume on its present
+    /// reference shape (after a split or a node move).
+    // docs/physics-notes.md, "Nakao": the tet keeps the material it carried.
+    fn refit_tet(&mut self, t: usize) {
+        let p = self.tets[t].map(|i| self.reference[i as usize]);
+        let frames = edge_frames(p);
+        self.tet_k[t] = self.tet_material[t].fit(&frames, signed_volume(p), self.tet_k[t]);
+    }
+
+    /// The springs of node `v` from its tets. Each edge's shares are summed in tet order,
+    /// so both ends compute the same constant.
+    fn springs_from_tets(&self, v: u32) -> Vec<Spring> {
+        let mut pairs: Vec<(u32, u32, f64)> = Vec::new();
+        for &t in &self.node_tets[v as usize] {
+            let tet = self.tets[t as usize];
+            for (e, (i, j)) in TET_EDGES.iter().enumerate() {
+                let w = match (tet[*i] == v, tet[*j] == v) {
+                    (true, _) => tet[*j],
+                    (_, true) => tet[*i],
+                    _ => continue,
+                };
+                pairs.push((w, t, self.tet_k[t as usize][e]));
+            }
+        }
+        pairs.sort_unstable_by_key(|a| (a.0, a.1));
+        let (tension, law, k) = (
+            self.params.tension,
+            self.params.stiffness_law,
+            self.params.stiffness,
+        );
+        let x = &self.reference;
+        let mut out: Vec<Spring> = Vec::new();
+        let mut share = 0.0;
+        for (i, &(w, _, k_t)) in pairs.iter().enumerate() {
+            share += k_t;
+            if pairs.get(i + 1).is_some_and(|n| n.0 == w) {
+                continue;
+            }
+            let (a, b) = (v.min(w) as usize, v.max(w) as usize);
+            out.push(Spring {
+                node: w,
+                rest: tension.rest_length(x[a], x[b]),
+                stiffness: match law {
+                    StiffnessLaw::Uniform => k,
+                    StiffnessLaw::TetVolume => share,
+                },
+            });
+            share = 0.0;
+        }
+        out
+    }
+
+    /// The stiffness law's scale `c`, fixed on the uncut mesh (1 for `Uniform`).
+    pub fn stiffness_scale(&self) -> f64 {
+        self.stiffness_scale
+    }
+}
+
+/// The stiffness law's scale `c`, each tet's shares of its edges' constants, and the
+/// stiffness per unit volume they give each tet, on the uncut mesh.
+// PHYSICS.md §2.1 (k of eq. 1); the TetVolume law: docs/physics-notes.md, "Nakao".
+fn initial_stiffness(
+    params: &MassSpringParams,
+    x: &[DVec3],
+    tets: &[[u32; 4]],
+) -> (f64, Vec<[f64; 6]>, Vec<TetTensor>) {
+    let law = params.stiffness_law;
+    let shapes: Vec<([(DVec3, f64); 6], f64)> = tets
+        .iter()
+        .map(|tet| {
+            let p = tet.map(|i| x[i as usize]);
+            (edge_frames(p), signed_volume(p))
+        })
+        .collect();
+    // Σ_e W_e / d_e² = Σ_t Σ_{e ∈ t} V_t / d_e²: every tet-edge incidence.
+    let incidences = shapes
+        .iter()
+        .flat_map(|(f, v)| f.iter().map(move |&(_, d)| (*v, d)));
+    let edge_count = {
+        let mut e: Vec<(u32, u32)> = tets
+            .iter()
+            .flat_map(|t| TET_EDGES.map(|(a, b)| (t[a].min(t[b]), t[a].max(t[b]))))
+            .collect();
+        e.sort_unstable();
+        e.dedup();
+        e.len()
+    };
+    let scale = match law {
+        StiffnessLaw::Uniform => 1.0,
+        StiffnessLaw::TetVolume => {
+            let sum: f64 = incidences.map(|(v, d)| law.constant(1.0, 1.0, v, d)).sum();
+            if sum > 0.0 {
+                params.stiffness * edge_count as f64 / sum
+            } else {
+                1.0
+            }
+        }
+    };
+    let mut tet_k = Vec::with_capacity(tets.len());
+    let mut material = Vec::with_capacity(tets.len());
+    for (frames, v) in &shapes {
+        let k = frames.map(|(_, d)| law.constant(params.stiffness, scale, *v, d));
+        material.push(TetTensor::of_springs(frames, &k, *v));
+        tet_k.push(k);
+    }
+    (scale, tet_k, material)
 }
 
 /// Signed volume of the tet with corners `p`.
@@ -378,6 +504,7 @@ mod tests {
 
     use super::*;
     use crate::generate::block;
+    use crate::mesh::EdgeList;
 
     #[test]
     fn model_of_a_block_has_its_edges_and_mass() {

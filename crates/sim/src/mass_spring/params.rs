@@ -3,7 +3,7 @@
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use super::Tension;
+use super::{StiffnessLaw, Tension};
 
 /// Physical parameters of the mass-spring model, SI units.
 ///
@@ -13,6 +13,9 @@ use super::Tension;
 pub struct MassSpringParams {
     /// Spring constant k of every edge, N/m (PHYSICS.md §2.1).
     pub stiffness: f64,
+    /// How each edge's constant follows from `stiffness` and the mesh (the paper's
+    /// `Uniform`, or the default `TetVolume`, which keeps a split region's stiffness).
+    pub stiffness_law: StiffnessLaw,
     /// Node damping coefficient b in `F_diss = −b v`, N·s/m (PHYSICS.md §2.1).
     pub damping: f64,
     /// Density ρ for the node masses of eq. 4, kg/m³.
@@ -29,6 +32,7 @@ impl Default for MassSpringParams {
     fn default() -> Self {
         MassSpringParams {
             stiffness: 100.0,
+            stiffness_law: StiffnessLaw::TetVolume,
             damping: 0.05,
             density: 900.0,
             gravity: DVec3::new(0.0, 0.0, -9.81),

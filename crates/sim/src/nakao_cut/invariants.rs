@@ -157,10 +157,10 @@ fn check_springs(model: &MassSpringModel) -> Result<(), TopologyError> {
             if !model
                 .springs_of(j)
                 .iter()
-                .any(|b| b.node as usize == i && b.rest == s.rest)
+                .any(|b| b.node as usize == i && b.rest == s.rest && b.stiffness == s.stiffness)
             {
                 return Err(TopologyError::Springs(format!(
-                    "spring {i}-{j} is not mirrored with the same rest length"
+                    "spring {i}-{j} is not mirrored with the same rest length and constant"
                 )));
             }
             let expected = tension.rest_length(x[i.min(j)], x[i.max(j)]);

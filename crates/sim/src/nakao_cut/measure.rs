@@ -79,3 +79,59 @@ pub fn opening_width(model: &MassSpringModel, centre: DVec3, radius: f64) -> Opt
         .collect();
     (!gaps.is_empty()).then(|| gaps.iter().sum::<f64>() / gaps.len() as f64)
 }
+
+/// Aspect-ratio quality of the tet with corners `p`: the radius ratio `3 r_in / R_circ`,
+/// 1 for a regular tet, towards 0 for slivers and needles (0 for a flat one).
+pub fn radius_ratio(p: [DVec3; 4]) -> f64 {
+    let (a, b, c) = (p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+    let six_v = a.dot(b.cross(c)).abs();
+    if six_v <= 0.0 {
+        return 0.0;
+    }
+    let area = |x: DVec3, y: DVec3, z: DVec3| 0.5 * (y - x).cross(z - x).length();
+    let faces = area(p[1], p[2], p[3])
+        + area(p[0], p[2], p[3])
+        + area(p[0], p[1], p[3])
+        + area(p[0], p[1], p[2]);
+    let r_in = 0.5 * six_v / faces;
+    let num = b.cross(c) * a.length_squared()
+        + c.cross(a) * b.length_squared()
+        + a.cross(b) * c.length_squared();
+    let r_circ = num.length() / (2.0 * six_v);
+    (3.0 * r_in / r_circ).min(1.0)
+}
+
+/// The smallest radius ratio over the tets that hold a node numbered `first_new` or more
+/// (the tets a cut created), in the reference configuration; `None` when there is none.
+pub fn worst_new_tet_quality(model: &MassSpringModel, first_new: usize) -> Option<f64> {
+    let x = model.reference_positions();
+    model
+        .tets()
+        .iter()
+        .filter(|t| t.iter().any(|&v| v as usize >= first_new))
+        .map(|t| radius_ratio(t.map(|v| x[v as usize])))
+        .min_by(f64::total_cmp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radius_ratio_is_one_for_a_regular_tet_and_small_for_a_sliver() {
+        let s = 1.0 / 2f64.sqrt();
+        let regular = [
+            DVec3::new(1.0, 0.0, -s),
+            DVec3::new(-1.0, 0.0, -s),
+            DVec3::new(0.0, 1.0, s),
+            DVec3::new(0.0, -1.0, s),
+        ];
+        assert!((radius_ratio(regular) - 1.0).abs() < 1e-12);
+        let sliver = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.01), DVec3::Y];
+        assert!(radius_ratio(sliver) < 0.05, "{}", radius_ratio(sliver));
+        assert_eq!(
+            radius_ratio([DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::X]),
+            0.0
+        );
+    }
+}

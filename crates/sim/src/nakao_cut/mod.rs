@@ -6,6 +6,7 @@
 
 mod bisect;
 mod blade;
+mod chest_experiment;
 mod chest_slab;
 mod crossing;
 mod cutter;
@@ -19,6 +20,9 @@ mod snap;
 mod split_order;
 
 pub use blade::{BladePose, SweptRegion};
+pub use chest_experiment::{
+    CHEST_TENSION, ChestLoop, ChestRun, chest_model, run_chest_cut, sternum_blade,
+};
 pub use chest_slab::{CHEST_SLAB_SIZE, chest_slab_model, slab_blade};
 pub use cutter::{CutParams, CutReport, Cutter, Subdivision};
 pub use plate_experiment::{PlateCutResult, PlateCutSetup, plate_model, run_plate_cut};

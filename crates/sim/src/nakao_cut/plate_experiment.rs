@@ -7,7 +7,7 @@ use std::time::Instant;
 use glam::DVec3;
 use serde::Serialize;
 
-use super::measure::{MeshCounts, counts, cut_surface_area, opening_width};
+use super::measure::{MeshCounts, counts, cut_surface_area, opening_width, worst_new_tet_quality};
 use super::{BladePose, CutParams, Cutter, Subdivision};
 use crate::generate::plate;
 use crate::mass_spring::{AxisMask, MassSpringError, MassSpringModel, MassSpringParams, Tension};
@@ -85,8 +85,17 @@ pub struct PlateCutResult {
     pub max_cut_ms: f64,
     /// Smallest dihedral angle of the tets the cut created, degrees.
     pub worst_dihedral_deg: f64,
+    /// Smallest aspect-ratio quality (radius ratio `3 r_in / R_circ`, 1 = regular) of the
+    /// tets holding a node the cut created.
+    pub worst_new_radius_ratio: f64,
     /// Kinetic energy at the end, J (how settled the wound is).
     pub final_kinetic_energy: f64,
+    /// Edges split at a crossing, over the whole cut.
+    pub split_edges: usize,
+    /// Nodes duplicated to open the cut (split points and original nodes on the cut).
+    pub duplicated_nodes: usize,
+    /// Nodes moved onto the cut boundary or plane (adaptive).
+    pub moved_nodes: usize,
 }
 
 /// The tensioned plate model: rim nodes held, every node held in depth (all nodes of the
@@ -136,6 +145,7 @@ pub fn run_plate_cut(
     let loops = (length / setup.advance).ceil().max(1.0) as usize;
     let (mut max_loop_ms, mut max_cut_ms) = (0.0f64, 0.0f64);
     let mut worst = f64::INFINITY;
+    let (mut split_edges, mut duplicated_nodes, mut moved_nodes) = (0, 0, 0);
     for k in 1..=loops {
         let s = (k as f64 * setup.advance).min(length);
         let t0 = Instant::now();
@@ -144,6 +154,9 @@ pub fn run_plate_cut(
         max_loop_ms = max_loop_ms.max(t0.elapsed().as_secs_f64() * 1e3);
         max_cut_ms = max_cut_ms.max(r.ms);
         worst = worst.min(r.worst_dihedral_deg);
+        split_edges += r.split_edges;
+        duplicated_nodes += r.duplicated_nodes;
+        moved_nodes += r.moved_nodes;
     }
     cutter.end();
     model.advance(setup.settle_after);
@@ -158,7 +171,11 @@ pub fn run_plate_cut(
         max_loop_ms,
         max_cut_ms,
         worst_dihedral_deg: worst,
+        worst_new_radius_ratio: worst_new_tet_quality(&model, before.nodes).unwrap_or(1.0),
         final_kinetic_energy: model.kinetic_energy(),
+        split_edges,
+        duplicated_nodes,
+        moved_nodes,
     };
     Ok((result, model))
 }
