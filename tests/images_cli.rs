@@ -66,7 +66,10 @@ fn assert_tissue_and_cut(what: &str, img: &RgbaImage, body: ScreenBox, cut: (Vec
         "{what}: only {:.1} % of the body's screen box {body:?} is tissue",
         tissue * 100.0
     );
-    let (near, band) = cut_near_segment(img, cut.0, cut.1, 6.0);
+    // The band around the incision: the slot's half-width plus the blade's lateral play,
+    // about 1/32 of the image's width (at least 6 pixels).
+    let r = (img.width as f32 / 32.0).max(6.0);
+    let (near, band) = cut_near_segment(img, cut.0, cut.1, r);
     let all = count(img, is_cut);
     assert!(
         near >= 15,
@@ -215,4 +218,188 @@ fn simulated_headset_eyes_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
             assert_devices_agree("xr eye", &cpu[i], img);
         }
     }
+}
+
+const EXERCISE: &str = "config/exercises/slab_depth.ron";
+const EXERCISE_STROKE: &str = "config/strokes/slab_depth_reference.ron";
+/// slab_depth's planned incision on the 8 mm slab's top.
+const SLAB_PLAN: (Vec3, Vec3) = (Vec3::new(0.025, 0.02, 0.008), Vec3::new(0.055, 0.02, 0.008));
+
+/// `incise exercise slab_depth --stroke <reference> --device DEVICE` into a scratch
+/// folder (the CPU attempt is made once and shared by the tests of this file).
+fn exercise_attempt(device: &str) -> std::path::PathBuf {
+    let make = || {
+        let dir = temp_dir(&format!("images-exercise-{device}"));
+        let out = dir.join("attempt");
+        let o = incise(&[
+            "exercise",
+            EXERCISE,
+            "--stroke",
+            EXERCISE_STROKE,
+            "--device",
+            device,
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--history",
+            dir.join("history.jsonl").to_str().unwrap(),
+        ]);
+        assert!(
+            o.status.success(),
+            "exercise on {device}: {}",
+            text(&o.stderr)
+        );
+        out
+    };
+    static CPU: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    match device {
+        "cpu" => CPU.get_or_init(make).clone(),
+        _ => make(),
+    }
+}
+
+/// Half the size (each output pixel the mean of 2 × 2), for small golden images.
+fn halved(img: &RgbaImage) -> RgbaImage {
+    let (w, h) = (img.width / 2, img.height / 2);
+    let mut out = RgbaImage::filled(w, h, [0, 0, 0, 255]);
+    for y in 0..h {
+        for x in 0..w {
+            let mut sum = [0u32; 4];
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let p = img.get(2 * x + dx, 2 * y + dy);
+                (0..4).for_each(|c| sum[c] += p[c] as u32);
+            }
+            out.set(x, y, sum.map(|s| (s / 4) as u8));
+        }
+    }
+    out
+}
+
+/// The exercise attempt's pictures (`frame_00000.png` before, `frame_NNNNN.png` after
+/// the stroke) on the CPU and the GPU: the slab fills its box in both, the cut shows
+/// along the plan only after the stroke, the devices agree, and the CPU's after-picture
+/// matches its golden image (at half size).
+#[test]
+fn exercise_pictures_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
+    let pictures = |out: &Path| {
+        let mut last: Vec<_> = std::fs::read_dir(out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with("frame_") && n.ends_with(".png"))
+            .collect();
+        last.sort();
+        assert_eq!(last.len(), 2, "{last:?}");
+        last.iter()
+            .map(|n| RgbaImage::load_png(&out.join(n)).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let cpu = pictures(&exercise_attempt("cpu"));
+    let (w, h) = (cpu[0].width, cpu[0].height);
+    let (view, lo, hi) = scene_view("config/slab_layer.ron", w, h);
+    let body = projected_box(&view, lo, hi, w, h);
+    let size = Vec2::new(w as f32, h as f32);
+    let cut = (
+        view.project(SLAB_PLAN.0, size).unwrap(),
+        view.project(SLAB_PLAN.1, size).unwrap(),
+    );
+    let check = |what: &str, imgs: &[RgbaImage]| {
+        assert!(
+            share(&imgs[0], body, is_tissue) > 0.35,
+            "{what}: no slab before"
+        );
+        assert!(
+            count(&imgs[0], is_cut) < 50,
+            "{what}: a cut before the attempt"
+        );
+        assert_tissue_and_cut(what, &imgs[1], body, cut);
+    };
+    check("exercise on the CPU", &cpu);
+    assert_golden("exercise_slab_depth_after_cpu", &halved(&cpu[1]));
+    if gpu_here() {
+        let gpu = pictures(&exercise_attempt("gpu"));
+        check("exercise on the GPU", &gpu);
+        for (c, g) in cpu.iter().zip(&gpu) {
+            assert_devices_agree("exercise picture", c, g);
+        }
+    }
+}
+
+/// The headless browser: Debian's `chromium`, or `None` (the test is skipped, saying
+/// why) unless `INCISE_REQUIRE_BROWSER=1` (CI, where scripts/test.sh installs it).
+fn chromium() -> Option<&'static str> {
+    let found = std::process::Command::new("chromium")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if found {
+        return Some("chromium");
+    }
+    assert!(
+        std::env::var("INCISE_REQUIRE_BROWSER").map_or(true, |v| v != "1"),
+        "INCISE_REQUIRE_BROWSER=1 but chromium is not installed (scripts/test.sh installs it)"
+    );
+    eprintln!("skipping: chromium is not installed");
+    None
+}
+
+/// The exercise's report.html in headless Chromium, offline: it refers to nothing outside
+/// itself (every image inlined, no http/https URL), loads with no console message (the
+/// page has no script; an error would be logged), and its screenshot shows the two plots'
+/// lines and the two pictures of the slab with the cut.
+#[test]
+fn exercise_report_opens_in_a_headless_browser_offline() {
+    let Some(browser) = chromium() else {
+        return;
+    };
+    let attempt = exercise_attempt("cpu");
+    let html = std::fs::read_to_string(attempt.join("report.html")).unwrap();
+    assert!(
+        !html.contains("http://") && !html.contains("https://") && !html.contains("src=\"//"),
+        "report.html refers to an external URL"
+    );
+    let srcs: Vec<&str> = html.split("src=\"").skip(1).collect();
+    assert_eq!(srcs.len(), 4, "two plots and two pictures");
+    assert!(
+        srcs.iter().all(|s| s.starts_with("data:image/png;base64,")),
+        "an image is not inlined"
+    );
+    let dir = temp_dir("images-browser");
+    let shot = dir.join("report.png");
+    let o = std::process::Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--no-first-run",
+            "--hide-scrollbars",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--window-size=1000,3400",
+        ])
+        .arg(format!("--user-data-dir={}", dir.join("profile").display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}", attempt.join("report.html").display()))
+        .env("XDG_RUNTIME_DIR", &dir)
+        .output()
+        .expect("chromium runs");
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "chromium failed: {err}");
+    let console: Vec<&str> = err.lines().filter(|l| l.contains(":CONSOLE")).collect();
+    assert!(console.is_empty(), "console messages: {console:?}");
+    let img = RgbaImage::load_png(&shot).unwrap();
+    // The plots' first series (the blade force, the cut depth) in the palette's blue.
+    let blue = count(&img, |p| {
+        p[0].abs_diff(31) < 30 && p[1].abs_diff(119) < 30 && p[2].abs_diff(180) < 30
+    });
+    assert!(blue > 1500, "plot lines: {blue} blue pixels");
+    let tissue = count(&img, is_tissue);
+    assert!(
+        tissue > 150_000,
+        "the two pictures' slab: {tissue} tissue pixels"
+    );
+    let cut = count(&img, is_cut);
+    assert!(cut > 2_000, "the cut in the after-picture: {cut} pixels");
 }
