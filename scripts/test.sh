@@ -5,5 +5,5 @@
 # fails them instead of skipping.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/ensure-deps.sh
+INCISE_TEST_DEPS=1 source scripts/ensure-deps.sh
 cargo test --workspace --release --locked "$@"
