@@ -159,8 +159,10 @@ fn main() -> ExitCode {
             target: BenchTarget::Render,
             json,
             frames,
-            ..
-        } => bench_render::run(frames, json),
+            case,
+            device,
+            scaling,
+        } => bench_render::run(frames, json, case, device, scaling),
         Command::Bench {
             target: BenchTarget::Solver,
             json,
@@ -242,6 +244,10 @@ fn main() -> ExitCode {
             }
             ExperimentCommand::NakaoPlate { out } => {
                 experiment::nakao::run(&experiment::nakao::NakaoOptions { out })
+                    .map(|table| print!("{table}"))
+            }
+            ExperimentCommand::SceneFigures { scenes, update } => {
+                experiment::scene_figures::run(&scenes, update.as_deref())
                     .map(|table| print!("{table}"))
             }
             ExperimentCommand::NakaoBench {

@@ -3,3 +3,4 @@
 pub mod nakao;
 pub mod nakao_bench;
 pub mod rheology;
+pub mod scene_figures;
