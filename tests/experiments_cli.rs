@@ -105,7 +105,10 @@ fn experiment_nakao_plate_writes_its_table_and_results() {
     }
     let r: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
-    assert!(r.as_array().is_some_and(|a| a.len() == 7), "seven cases: {r}");
+    assert!(
+        r.as_array().is_some_and(|a| a.len() == 7),
+        "seven cases: {r}"
+    );
     assert!(
         std::fs::read_dir(&out).unwrap().any(|e| e
             .unwrap()
