@@ -7,7 +7,7 @@
 # fails the run, elsewhere those tests skip.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/ensure-deps.sh
+INCISE_TEST_DEPS=1 source scripts/ensure-deps.sh
 if manifest="$(bash scripts/monado.sh)"; then
     export INCISE_MONADO_MANIFEST="$manifest"
 elif [ -n "${CI:-}" ] || [ "${INCISE_REQUIRE_XR:-0}" = 1 ]; then

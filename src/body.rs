@@ -1,7 +1,7 @@
 //! The simulated body on the device the user chose: the CPU reference solver or the GPU
 //! solver (whose host mirror carries the same accessors).
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::ValueEnum;
 use incise_sim::Solver;
 use incise_sim::gpu::{GpuContext, GpuSolver};
@@ -16,6 +16,41 @@ pub enum DeviceChoice {
     Cpu,
     /// The wgpu compute solver; an error when no adapter exists.
     Gpu,
+}
+
+/// A compute context on the best adapter, opened as the renderer's headless device is
+/// (primary backends first, so a machine without a display prints no window-system
+/// errors), with the limits the GPU solver needs.
+fn gpu_context() -> Result<GpuContext> {
+    Ok(incise_xr::RenderDevice::headless()
+        .context("opening the GPU solver's device")?
+        .compute_context())
+}
+
+/// Where `--device auto` runs the solver on a machine whose best adapter is `adapter`,
+/// and the sentence saying why. A hardware GPU (discrete, integrated or virtual) gets the
+/// GPU solver. A software adapter (Mesa's lavapipe/llvmpipe, WARP: `DeviceType::Cpu`)
+/// runs the GPU kernels on the CPU's own cores through an emulation layer, so the CPU
+/// solver is faster there (measured on the default scene: lavapipe 1.17–1.29× slower
+/// than the CPU solver on the same cores, issue 18); it gets the CPU solver.
+pub fn auto_device(adapter: &wgpu::AdapterInfo) -> (DeviceChoice, String) {
+    let name = format!(
+        "{} ({:?}, {:?})",
+        adapter.name, adapter.backend, adapter.device_type
+    );
+    match adapter.device_type {
+        wgpu::DeviceType::Cpu => (
+            DeviceChoice::Cpu,
+            format!(
+                "--device auto: cpu, because the only GPU adapter, {name}, is a software \
+                 one running on the CPU, where the CPU solver is faster"
+            ),
+        ),
+        _ => (
+            DeviceChoice::Gpu,
+            format!("--device auto: gpu, because {name} is a hardware GPU"),
+        ),
+    }
 }
 
 /// A solver on the CPU or the GPU.
@@ -33,13 +68,20 @@ impl Body {
         match choice {
             DeviceChoice::Cpu => Ok(Body::Cpu(Box::new(solver))),
             DeviceChoice::Gpu => {
-                let ctx = GpuContext::new()?;
+                let ctx = gpu_context()?;
                 Ok(Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?)))
             }
-            DeviceChoice::Auto => match GpuContext::new() {
-                Ok(ctx) => Ok(Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?))),
+            DeviceChoice::Auto => match gpu_context() {
+                Ok(ctx) => {
+                    let (pick, why) = auto_device(&ctx.info);
+                    notice(&why);
+                    Ok(match pick {
+                        DeviceChoice::Gpu => Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?)),
+                        _ => Body::Cpu(Box::new(solver)),
+                    })
+                }
                 Err(e) => {
-                    notice(&format!("{e}; running on the CPU"));
+                    notice(&format!("--device auto: cpu, because {e:#}"));
                     Ok(Body::Cpu(Box::new(solver)))
                 }
             },

@@ -288,6 +288,17 @@ pub enum ExperimentCommand {
         #[arg(long, default_value_t = 120)]
         loops: usize,
     },
+    /// The scene figures the documents quote (frames, tets, released tets, peak tool
+    /// force; CPU solver), as a markdown table; `--update FILE` rewrites that table
+    /// between its markers in FILE (docs/performance.md).
+    SceneFigures {
+        /// Scenes to run to their end.
+        #[arg(default_values = ["config/plate_cut.ron", "config/slab_layer.ron"])]
+        scenes: Vec<PathBuf>,
+        /// Rewrite the generated table in this document.
+        #[arg(long)]
+        update: Option<PathBuf>,
+    },
     /// Loop times of the mass-spring cutter on a chest-scale slab (18.5k nodes, 72k tets):
     /// levels 4 and 6, the whole mesh, the refresh-rate manager and the blade advances.
     NakaoBench {

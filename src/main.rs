@@ -161,8 +161,11 @@ fn main() -> ExitCode {
             target: BenchTarget::Render,
             json,
             frames,
+            case,
+            device,
+            scaling,
             ..
-        } => bench_render::run(frames, json),
+        } => bench_render::run(frames, json, case, device, scaling),
         Command::Bench {
             target: BenchTarget::Realtime,
             json,
@@ -262,6 +265,10 @@ fn main() -> ExitCode {
                     loops,
                 })
                 .map(|table| print!("{table}"))
+            }
+            ExperimentCommand::SceneFigures { scenes, update } => {
+                experiment::scene_figures::run(&scenes, update.as_deref())
+                    .map(|table| print!("{table}"))
             }
             ExperimentCommand::NakaoBench {
                 loops,

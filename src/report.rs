@@ -133,6 +133,9 @@ pub struct Report {
     pub threads: usize,
     /// Device the solver ran on: "cpu" or the GPU adapter's name, backend and type.
     pub device: String,
+    /// With `--device auto`: which device it picked and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub device_choice: Option<String>,
     /// The scalpel, when the scene has one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tool: Option<ToolInfo>,

@@ -145,11 +145,11 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         }
     };
     let quiet = opts.quiet;
-    let mut body = Body::place(solver, opts.device, |m| {
-        if !quiet {
-            eprintln!("note: {m}");
-        }
-    })?;
+    let mut device_choice = None;
+    let mut body = Body::place(solver, opts.device, |m| device_choice = Some(m.to_string()))?;
+    if let Some(m) = device_choice.as_ref().filter(|_| !quiet) {
+        eprintln!("note: {m}");
+    }
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("creating {}", opts.out.display()))?;
     let solver = body.solver();
@@ -188,6 +188,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
         solver: solver.params().clone(),
         threads,
         device: body.device(),
+        device_choice,
         tool: tool.as_ref().map(|(t, stroke)| ToolInfo {
             name: t.tool.name().to_string(),
             spheres: t.contact.spheres.len(),

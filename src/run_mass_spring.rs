@@ -104,6 +104,7 @@ pub fn run(scene: &Scene, ms: &MassSpringScene, opts: &RunOptions) -> Result<Run
         solver: scene.solver.clone(),
         threads: 1,
         device: "cpu (mass-spring)".into(),
+        device_choice: None,
         frames: Vec::with_capacity(frames as usize),
         snapshots: Vec::new(),
         rheology: None,

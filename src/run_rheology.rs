@@ -165,6 +165,7 @@ pub fn run(scene: &Scene, rh: &RheologyScene, opts: &RunOptions) -> Result<RunOu
         solver: scene.solver.clone(),
         threads: 1,
         device: "cpu (rheology)".into(),
+        device_choice: None,
         frames: Vec::with_capacity(frames as usize),
         snapshots: Vec::new(),
         rheology: Some(RheologyInfo {

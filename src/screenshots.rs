@@ -15,7 +15,7 @@ use incise_xr::{
     BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View,
 };
 
-use crate::body::{Body, DeviceChoice};
+use crate::body::{Body, DeviceChoice, auto_device};
 use crate::exercise::PlanDecal;
 
 /// An image size `WIDTHxHEIGHT` given on the command line.
@@ -86,13 +86,16 @@ pub fn stress_scale(solver: &Solver) -> f32 {
 }
 
 /// Put `solver` on the chosen device; a GPU body is opened on `dev`, so the renderer can
-/// copy its node positions on the device.
+/// copy its node positions on the device. `auto` is decided by [`auto_device`] from
+/// `dev`'s adapter (a software one gets the CPU solver).
 pub fn place_on(solver: Solver, choice: DeviceChoice, dev: &RenderDevice) -> Result<Body> {
+    let choice = match choice {
+        DeviceChoice::Auto => auto_device(&dev.info).0,
+        c => c,
+    };
     Ok(match choice {
-        DeviceChoice::Cpu => Body::Cpu(Box::new(solver)),
-        DeviceChoice::Gpu | DeviceChoice::Auto => {
-            Body::Gpu(Box::new(GpuSolver::new(solver, &dev.compute_context())?))
-        }
+        DeviceChoice::Gpu => Body::Gpu(Box::new(GpuSolver::new(solver, &dev.compute_context())?)),
+        _ => Body::Cpu(Box::new(solver)),
     })
 }
 

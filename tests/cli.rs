@@ -211,6 +211,100 @@ fn shipped_scenes_build() {
     }
 }
 
+/// Every shipped scene (each `config/*.ron` but the preset files) runs three frames from
+/// the command line and completes with its mesh and frames in report.json; the folder
+/// holds the nine scenes the README lists.
+#[test]
+fn every_shipped_scene_runs() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
+    let dir = temp_dir("shipped");
+    let mut scenes: Vec<_> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .filter(|p| {
+            !["materials.ron", "rheology.ron"].contains(&p.file_name().unwrap().to_str().unwrap())
+        })
+        .collect();
+    scenes.sort();
+    assert_eq!(scenes.len(), 9, "{scenes:?}");
+    for scene in &scenes {
+        let name = scene.file_stem().unwrap().to_str().unwrap();
+        let out = dir.join(name);
+        let o = incise(&[
+            "run",
+            scene.to_str().unwrap(),
+            "--frames",
+            "3",
+            "--vtu-every",
+            "0",
+            "--device",
+            "cpu",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{name}: {}", text(&o.stderr));
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        assert_eq!(r["status"], "completed", "{name}");
+        assert_eq!(r["frames"].as_array().unwrap().len(), 3, "{name}");
+        assert!(r["mesh"]["tets"].as_u64().unwrap() > 0, "{name}");
+    }
+}
+
+/// `--device auto` says in report.json what it picked and why: on a software adapter
+/// (lavapipe, as in CI) the CPU solver, which is faster there; on a hardware GPU the GPU;
+/// without an adapter the CPU.
+#[test]
+fn device_auto_picks_the_faster_path_and_says_why() {
+    let dir = temp_dir("auto");
+    let o = incise(&[
+        "run",
+        "config/beam_sag.ron",
+        "--frames",
+        "2",
+        "--vtu-every",
+        "0",
+        "--device",
+        "auto",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap();
+    let (device, why) = (
+        r["device"].as_str().unwrap(),
+        r["device_choice"].as_str().unwrap(),
+    );
+    assert!(text(&o.stderr).contains(why), "the choice is also printed");
+    match incise_xr::RenderDevice::headless() {
+        Ok(dev) if dev.info.device_type == wgpu::DeviceType::Cpu => {
+            assert_eq!(device, "cpu", "{why}");
+            assert!(
+                why.contains("software") && why.contains(&dev.info.name),
+                "{why}"
+            );
+        }
+        Ok(dev) => {
+            assert!(device.starts_with("gpu"), "{device}: {why}");
+            assert!(
+                why.contains("hardware") && why.contains(&dev.info.name),
+                "{why}"
+            );
+        }
+        Err(_) => {
+            assert!(
+                !common::gpu_required(),
+                "INCISE_REQUIRE_GPU=1 but no adapter"
+            );
+            assert_eq!(device, "cpu");
+            assert!(why.contains("no GPU adapter"), "{why}");
+        }
+    }
+}
+
 /// The default scene tears: run its first 90 frames (1.5 s) and expect released tets and
 /// a wall that comes apart into more than one piece.
 #[test]
@@ -242,7 +336,7 @@ fn intestine_pull_tears() {
 fn device_gpu_matches_device_cpu() {
     if incise_sim::gpu::GpuContext::new().is_err() {
         assert!(
-            std::env::var("INCISE_REQUIRE_GPU").map_or(true, |v| v != "1"),
+            !common::gpu_required(),
             "INCISE_REQUIRE_GPU=1 but no adapter"
         );
         eprintln!("skipping: no GPU adapter");
@@ -285,7 +379,7 @@ fn device_gpu_matches_device_cpu() {
 fn compare_finds_cpu_and_gpu_in_agreement() {
     if incise_sim::gpu::GpuContext::new().is_err() {
         assert!(
-            std::env::var("INCISE_REQUIRE_GPU").map_or(true, |v| v != "1"),
+            !common::gpu_required(),
             "INCISE_REQUIRE_GPU=1 but no adapter"
         );
         eprintln!("skipping: no GPU adapter");

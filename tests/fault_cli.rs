@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{incise, temp_dir, text};
+use common::{gpu_required, incise, temp_dir, text};
 
 fn report(dir: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
@@ -14,11 +14,16 @@ fn report(dir: &std::path::Path) -> serde_json::Value {
 #[test]
 fn a_lost_gpu_hands_the_run_to_the_cpu() {
     let out = temp_dir("fault-gpu");
+    if incise_sim::gpu::GpuContext::new().is_err() {
+        assert!(!gpu_required(), "no GPU under INCISE_REQUIRE_GPU=1");
+        eprintln!("skipping: no GPU adapter");
+        return;
+    }
     let o = incise(&[
         "run",
         "config/plate_cut.ron",
         "--device",
-        "auto",
+        "gpu",
         "--frames",
         "20",
         "--vtu-every",
@@ -37,21 +42,17 @@ fn a_lost_gpu_hands_the_run_to_the_cpu() {
     if device.starts_with("gpu") {
         panic!("the run stayed on the GPU after the loss: {device}");
     }
-    if device.contains("after a GPU failure") {
-        let w = r["warnings"][0].as_str().unwrap();
-        assert!(w.contains("frame 8") && w.contains("CPU"), "{w}");
-    } else {
-        // No adapter at all: --device auto ran on the CPU from the start.
-        assert!(
-            std::env::var("INCISE_REQUIRE_GPU").is_err(),
-            "no GPU under INCISE_REQUIRE_GPU=1"
-        );
-    }
+    assert!(device.contains("after a GPU failure"), "{device}");
+    let w = r["warnings"][0].as_str().unwrap();
+    assert!(w.contains("frame 8") && w.contains("CPU"), "{w}");
 }
 
 #[test]
 fn a_nan_stops_the_run_naming_frame_and_tet_and_keeps_the_output() {
-    for device in ["cpu", "auto"] {
+    let gpu = incise_sim::gpu::GpuContext::new().is_ok();
+    assert!(gpu || !gpu_required(), "no GPU under INCISE_REQUIRE_GPU=1");
+    let devices: &[&str] = if gpu { &["cpu", "gpu"] } else { &["cpu"] };
+    for &device in devices {
         let out = temp_dir(&format!("fault-nan-{device}"));
         let o = incise(&[
             "run",

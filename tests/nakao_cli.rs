@@ -97,7 +97,13 @@ fn haptic_rate_loop_runs_beside_the_report_loop() {
     let wall = h["wall_s"].as_f64().unwrap();
     let rate = h["achieved_hz"].as_f64().unwrap();
     assert_eq!(h["requested_hz"], 1000.0);
-    assert!(loops > 0, "the haptic thread ran no loop");
+    // A 1 kHz loop, not one tied to the 100 Hz report loop: measured 660–790 Hz on 2
+    // cores at load average 8–11; 300 Hz leaves room for a busier CI machine while a
+    // loop that ran once per report frame (≤ 100 Hz) fails.
+    assert!(
+        rate >= 300.0,
+        "the haptic loop ran at {rate:.0} Hz ({loops} loops), not near 1 kHz"
+    );
     assert!(wall >= 0.6, "the report loop ran in real time: {wall} s");
     // The rate reported is the one measured: loops over wall time.
     assert!((rate - loops as f64 / wall).abs() < 1e-6 * rate, "{h}");

@@ -11,6 +11,7 @@
 
 mod common;
 
+use common::pixels::{assert_devices_agree, is_cut, is_tissue, projected_box, scene_view, share};
 use common::temp_dir;
 
 use std::io::{BufRead, BufReader};
@@ -26,6 +27,11 @@ fn required() -> bool {
 /// (the test is skipped, saying why) without xvfb-run or a GPU adapter unless
 /// `INCISE_REQUIRE_GPU=1`.
 fn preview_screenshot(name: &str, args: &[&str]) -> Option<RgbaImage> {
+    preview_screenshot_on(name, args, "cpu")
+}
+
+/// [`preview_screenshot`] with the solver on `device`.
+fn preview_screenshot_on(name: &str, args: &[&str], device: &str) -> Option<RgbaImage> {
     if Command::new("xvfb-run").arg("--help").output().is_err() {
         assert!(
             !required(),
@@ -41,7 +47,7 @@ fn preview_screenshot(name: &str, args: &[&str]) -> Option<RgbaImage> {
         .arg(env!("CARGO_BIN_EXE_incise"))
         .arg("preview")
         .args(args)
-        .args(["--device", "cpu", "--screenshot"])
+        .args(["--device", device, "--screenshot"])
         .arg(&shot)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env("XDG_RUNTIME_DIR", &dir)
@@ -236,5 +242,77 @@ fn without_a_display_preview_refuses_and_the_default_runs_headless() {
     assert!(
         first.contains("no display") && first.contains("headless"),
         "{first}"
+    );
+}
+
+/// The window's width taken by the side panel: the first column of the bottom row that
+/// has the 3D view's background colour (the top-right pixel).
+fn panel_width(img: &RgbaImage) -> u32 {
+    let bg = img.get(img.width - 1, 0);
+    (0..img.width)
+        .find(|&x| img.get(x, img.height - 1)[..3] == bg[..3])
+        .expect("no 3D view in the window")
+}
+
+/// The right part of `img` from column `x0` on.
+fn crop_right(img: &RgbaImage, x0: u32) -> RgbaImage {
+    let mut out = RgbaImage::filled(img.width - x0, img.height, [0, 0, 0, 255]);
+    for y in 0..img.height {
+        for x in x0..img.width {
+            out.set(x - x0, y, img.get(x, y));
+        }
+    }
+    out
+}
+
+/// The preview's window after 72 frames of plate_cut's stroke, with the solver on the
+/// CPU and on the GPU (issue 18: the GPU path drew only the scalpel): the slab fills its
+/// box (the preview camera, the view shifted right by half the panel), the cut surface
+/// shows, and the two 3D views agree.
+#[test]
+fn preview_window_shows_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
+    let args = [
+        "config/plate_cut.ron",
+        "--frames",
+        "72",
+        "--size",
+        "640x400",
+    ];
+    let Some(cpu) = preview_screenshot_on("xvfb-cpu", &args, "cpu") else {
+        return;
+    };
+    let (w, h) = (cpu.width, cpu.height);
+    let panel = panel_width(&cpu);
+    assert!((100..w / 2).contains(&panel), "panel {panel} px wide");
+    let (_, lo, hi) = scene_view("config/plate_cut.ron", w, h);
+    // The preview's camera: the default one zoomed out 1.3× (src/preview/mod.rs), its
+    // picture centred in the part of the window the panel leaves free.
+    let scene = incise::scene::load_scene(std::path::Path::new("config/plate_cut.ron")).unwrap();
+    let built =
+        incise::scene::build_scene(&scene, std::path::Path::new("config/plate_cut.ron"), None)
+            .unwrap();
+    let mut cam = incise::screenshots::default_camera(built.solver.mesh());
+    cam.zoom(1.3);
+    let mut view = cam.view(w as f32 / h as f32);
+    let shift = panel as f32 / w as f32;
+    view.proj = glam::Mat4::from_translation(glam::Vec3::new(shift, 0.0, 0.0)) * view.proj;
+    let body = projected_box(&view, lo, hi, w, h);
+    let check = |what: &str, img: &RgbaImage| {
+        let tissue = share(img, body, is_tissue);
+        assert!(
+            tissue > 0.35,
+            "{what}: {:.1} % tissue in {body:?}",
+            tissue * 100.0
+        );
+        let cut = share(img, body, is_cut) * body.area() as f64;
+        assert!(cut > 30.0, "{what}: {cut} cut-surface pixels");
+    };
+    check("preview on the CPU", &cpu);
+    let gpu = preview_screenshot_on("xvfb-gpu", &args, "gpu").expect("the CPU preview ran");
+    check("preview on the GPU", &gpu);
+    assert_devices_agree(
+        "preview 3D view",
+        &crop_right(&cpu, panel),
+        &crop_right(&gpu, panel),
     );
 }

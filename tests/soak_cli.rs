@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{incise, temp_dir, text};
+use common::{gpu_required, incise, temp_dir, text};
 
 fn soak(device: &str) {
     let seconds = std::env::var("INCISE_SOAK_SECONDS").unwrap_or_else(|_| "150".into());
@@ -36,7 +36,7 @@ fn soak_on_the_cpu() {
 
 #[test]
 fn soak_on_the_gpu() {
-    if incise_sim::gpu::GpuContext::new().is_err() && std::env::var("INCISE_REQUIRE_GPU").is_err() {
+    if incise_sim::gpu::GpuContext::new().is_err() && !gpu_required() {
         eprintln!("skipping the GPU soak: no adapter");
         return;
     }

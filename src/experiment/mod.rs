@@ -5,3 +5,4 @@ pub mod nakao_bench;
 pub mod nakao_chest;
 pub mod nakao_counts;
 pub mod rheology;
+pub mod scene_figures;

@@ -224,10 +224,11 @@ impl Live {
         let gpu = WindowGpu::new(window.clone())?;
         let device = match opts.device {
             // A software adapter runs the CPU solver faster than its own compute.
-            DeviceChoice::Auto if gpu.dev.info.device_type == wgpu::DeviceType::Cpu => {
-                DeviceChoice::Cpu
+            DeviceChoice::Auto => {
+                let (pick, why) = crate::body::auto_device(&gpu.dev.info);
+                eprintln!("note: {why}");
+                pick
             }
-            DeviceChoice::Auto => DeviceChoice::Gpu,
             d => d,
         };
         let exercise = opts

@@ -1,6 +1,8 @@
 //! Helpers shared by the end-to-end tests: run the `incise` binary, scratch folders, text.
 #![allow(dead_code)]
 
+pub mod pixels;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -53,4 +55,10 @@ pub fn score_stroke(exercise: &str, stroke: &Path, out: &Path, history: &Path) -
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     o
+}
+
+/// Whether a GPU adapter is required here: `INCISE_REQUIRE_GPU=1` (CI) turns a missing
+/// adapter into a failure; unset or any other value (`0`) lets GPU tests skip.
+pub fn gpu_required() -> bool {
+    std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
 }

@@ -168,6 +168,7 @@ fn regressions_from_fuzzing_stay_fixed() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/regressions");
     let node_seed = seeds()[0].1[0].clone();
     let mut n = 0;
+    let mut covered = std::collections::BTreeSet::new();
     for entry in std::fs::read_dir(&dir).expect("regressions folder") {
         let path = entry.unwrap().path();
         let name = path.file_name().unwrap().to_string_lossy().to_string();
@@ -178,9 +179,22 @@ fn regressions_from_fuzzing_stay_fixed() {
             continue;
         };
         let bytes = std::fs::read(&path).unwrap();
+        let t = Instant::now();
         let r = std::panic::catch_unwind(|| parse(format, &bytes, &node_seed));
         assert!(r.is_ok(), "{} panics again", path.display());
+        // Each is malformed (a count far past the data, an index past the nodes, a
+        // truncated file): it must be rejected, quickly, without allocating the count.
+        assert_eq!(r.ok(), Some(false), "{} is accepted", path.display());
+        assert!(
+            t.elapsed().as_secs_f64() < 1.0,
+            "{} is slow",
+            path.display()
+        );
+        covered.insert(format);
         n += 1;
     }
     println!("{n} regression inputs");
+    for f in ["tetgen_node", "tetgen_ele", "gmsh", "vtk", "vtu", "obj"] {
+        assert!(covered.contains(f), "no regression input for {f}");
+    }
 }

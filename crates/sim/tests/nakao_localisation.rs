@@ -76,6 +76,32 @@ fn nodes_beyond_level_d_do_not_move() {
         assert!((ms - 0.1).abs() < 1e-9, "{phase}: {ms}");
     }
     assert_eq!(stats.level(), 4);
+    assert_eq!(
+        stats.free_nodes,
+        m.node_count() - frozen,
+        "stats count the free set"
+    );
+    // The free set is the level-d neighbourhood of the tool: a shallower level frees a
+    // strict subset of a deeper one around the same root.
+    let free_at = |max_level| {
+        let mut m = cut_plate();
+        let params = LocalLoopParams {
+            max_level,
+            ..LocalLoopParams::default()
+        };
+        let mut l = LocalLoop::new(params, StepClock(Default::default()));
+        l.step(&mut m, tip, dt);
+        (0..m.node_count() as u32)
+            .filter(|&i| l.hierarchy().is_free(i))
+            .collect::<std::collections::BTreeSet<_>>()
+    };
+    let (two, four) = (free_at(2), free_at(4));
+    assert!(
+        !two.is_empty() && two.len() < four.len() && two.is_subset(&four),
+        "level 2 frees {} nodes, level 4 {}",
+        two.len(),
+        four.len()
+    );
 }
 
 #[test]

@@ -28,11 +28,31 @@ pub struct RenderDevice {
 
 impl RenderDevice {
     /// Open a device without a window (offscreen rendering, benchmarks, tests). Honours
-    /// `WGPU_BACKEND` and friends.
+    /// `WGPU_BACKEND` and friends. Without it, Vulkan is opened without the window-system
+    /// extensions first ([`crate::headless_vulkan`]), then the other primary backends
+    /// (Metal, DX12), then GL: asking for Wayland/X11 surfaces (Mesa's device-select layer
+    /// then connects to the display) or starting GL (it probes the window systems) prints
+    /// "error: XDG_RUNTIME_DIR is invalid or not set" on a machine with no display.
     pub fn headless() -> Result<Self, RenderError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        pollster::block_on(Self::open(&instance, None))
+        let from_env = std::env::var_os("WGPU_BACKEND").is_some();
+        if !from_env
+            && let Some(vulkan) = crate::headless_vulkan::instance()
+            && let Ok(dev) = pollster::block_on(Self::open(&vulkan, None))
+        {
+            return Ok(dev);
+        }
+        let primary = wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::PRIMARY,
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        }
+        .with_env();
+        match pollster::block_on(Self::open(&wgpu::Instance::new(primary), None)) {
+            Err(RenderError::NoAdapter(_)) if !from_env => {
+                let all = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+                pollster::block_on(Self::open(&wgpu::Instance::new(all), None))
+            }
+            opened => opened,
+        }
     }
 
     /// Open a device on `instance` whose adapter can present to `surface`, if given.

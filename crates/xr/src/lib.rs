@@ -16,6 +16,7 @@ pub mod device;
 pub mod error;
 pub mod frame;
 mod gpu_skin;
+mod headless_vulkan;
 pub mod image_io;
 mod node_world;
 pub mod offscreen;

@@ -1,0 +1,74 @@
+//! A Vulkan instance for offscreen work, created without the window-system extensions
+//! (`VK_KHR_surface`, Xlib, XCB, Wayland, display): with them Mesa's device-select layer
+//! connects to the display to rank GPUs and, on a machine without one, prints "error:
+//! XDG_RUNTIME_DIR is invalid or not set" on every run. wgpu-hal enables every WSI
+//! extension the loader offers and has no switch for it, so the instance is made here and
+//! handed to wgpu-hal, which owns it from then on.
+
+use std::ffi::{CStr, c_char};
+
+use ash::vk;
+use wgpu::hal::vulkan as hal_vk;
+
+/// Instance extensions only a window needs.
+const WINDOW_SYSTEM: [&CStr; 10] = [
+    ash::khr::surface::NAME,
+    ash::khr::xlib_surface::NAME,
+    ash::khr::xcb_surface::NAME,
+    ash::khr::wayland_surface::NAME,
+    ash::khr::display::NAME,
+    ash::khr::get_display_properties2::NAME,
+    ash::ext::acquire_drm_display::NAME,
+    ash::ext::direct_mode_display::NAME,
+    ash::ext::swapchain_colorspace::NAME,
+    ash::khr::android_surface::NAME,
+];
+
+/// A wgpu instance on a window-less Vulkan instance, or `None` where Vulkan (≥ 1.1) is
+/// not there or refuses (the caller then opens wgpu's own instance).
+pub fn instance() -> Option<wgpu::Instance> {
+    // SAFETY: the system Vulkan loader is loaded and the instance created from it with
+    // the extensions listed; wgpu-hal is given exactly that list (it checks it before any
+    // surface use, and no surface is made on this instance) and takes ownership of the
+    // instance (no drop callback).
+    unsafe {
+        let entry = ash::Entry::load().ok()?;
+        let version = entry
+            .try_enumerate_instance_version()
+            .ok()?
+            .unwrap_or(vk::API_VERSION_1_0);
+        if version < vk::API_VERSION_1_1 {
+            return None;
+        }
+        let version = version.min(vk::API_VERSION_1_3);
+        let flags = wgpu::InstanceFlags::empty();
+        let mut extensions = hal_vk::Instance::desired_extensions(&entry, version, flags).ok()?;
+        extensions.retain(|e| !WINDOW_SYSTEM.contains(e));
+        let names: Vec<*const c_char> = extensions.iter().map(|e| e.as_ptr()).collect();
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"incise")
+            .engine_name(c"incise")
+            .api_version(version);
+        let info = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_extension_names(&names);
+        let raw = entry.create_instance(&info, None).ok()?;
+        let hal = hal_vk::Instance::from_raw(
+            entry,
+            raw.clone(),
+            version,
+            0,
+            None,
+            extensions,
+            flags,
+            wgpu::MemoryBudgetThresholds::default(),
+            false,
+            None,
+        );
+        let Ok(hal) = hal else {
+            raw.destroy_instance(None);
+            return None;
+        };
+        Some(wgpu::Instance::from_hal::<wgpu::hal::api::Vulkan>(hal))
+    }
+}

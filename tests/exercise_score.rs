@@ -1,0 +1,262 @@
+//! Unit tests of the exercise scoring (src/exercise/score.rs `judge`) and metrics
+//! (src/exercise/metrics.rs `compute`) on hand-made inputs with known answers, no
+//! simulation: the shipped slab_depth exercise, its slab at rest, tets released by
+//! hand and tool frames made up (docs/scoring.md has the formulas).
+
+use std::path::Path;
+
+use glam::{DVec3, Vec3};
+use incise::exercise::{LoadedExercise, Metrics, compute_metrics, judge, load_exercise};
+use incise_sim::xpbd::FrameStats;
+
+fn slab_depth() -> LoadedExercise {
+    load_exercise(&Path::new(env!("CARGO_MANIFEST_DIR")).join("config/exercises/slab_depth.ron"))
+        .unwrap()
+}
+
+/// An attempt that meets every target exactly (slab_depth's limits: lateral 3 mm, depth
+/// 3 ± 2.5 mm, 3 N, 4 s).
+fn perfect() -> Metrics {
+    Metrics {
+        plan_length: 0.03,
+        tet_edge: 0.0025,
+        released_tets: 100,
+        trace_faces: 40,
+        mean_deviation: Some(0.0),
+        max_deviation: Some(0.0),
+        completion: 1.0,
+        mean_depth_error: Some(0.0),
+        max_depth: 0.003,
+        collateral_volume: 0.0,
+        released_volume: 1e-7,
+        band_volume: 0.03 * 2.0 * 0.003 * 0.0055,
+        max_force: 1.0,
+        mean_force: 0.5,
+        strokes: 1,
+        duration: 2.0,
+        depth_profile: Vec::new(),
+        force_series: Vec::new(),
+    }
+}
+
+fn check<'a>(v: &'a incise::exercise::Verdict, name: &str) -> &'a incise::exercise::Check {
+    v.checks.iter().find(|c| c.name == name).unwrap()
+}
+
+#[test]
+fn a_perfect_attempt_scores_100_and_passes_every_check() {
+    let ex = slab_depth();
+    let v = judge(&ex.exercise, &perfect());
+    assert!((v.score - 100.0).abs() < 1e-9, "{}", v.score);
+    assert!(
+        v.passed && v.checks.iter().all(|c| c.passed),
+        "{:?}",
+        v.checks
+    );
+    assert_eq!(v.checks.len(), 9);
+}
+
+#[test]
+fn each_part_loses_points_in_proportion_to_its_tolerance() {
+    let ex = slab_depth();
+    // Half the lateral tolerance off the plan: half the 20 deviation points.
+    let m = Metrics {
+        mean_deviation: Some(0.0015),
+        max_deviation: Some(0.005),
+        ..perfect()
+    };
+    let v = judge(&ex.exercise, &m);
+    assert!((v.parts.deviation - 10.0).abs() < 1e-6, "{:?}", v.parts);
+    assert!((v.score - 90.0).abs() < 1e-6);
+    assert!(!check(&v, "max_deviation").passed, "5 mm > 4 mm allowed");
+    assert!(check(&v, "mean_deviation").passed, "1.5 mm ≤ 2 mm allowed");
+    assert!(!v.passed);
+    // 60 % of the plan: 18 of 30 completion points, and the 90 % condition fails.
+    let v = judge(
+        &ex.exercise,
+        &Metrics {
+            completion: 0.6,
+            ..perfect()
+        },
+    );
+    assert!((v.parts.completion - 18.0).abs() < 1e-6);
+    assert!(!check(&v, "completion").passed);
+    // 1.5× the force limit: half the 10 force points.
+    let v = judge(
+        &ex.exercise,
+        &Metrics {
+            max_force: 4.5,
+            ..perfect()
+        },
+    );
+    assert!((v.parts.force - 5.0).abs() < 1e-6, "{:?}", v.parts);
+    assert!(!check(&v, "max_force").passed);
+    // Twice the time limit: half the 5 time points.
+    let v = judge(
+        &ex.exercise,
+        &Metrics {
+            duration: 8.0,
+            ..perfect()
+        },
+    );
+    assert!((v.parts.time - 2.5).abs() < 1e-6);
+    assert!(!check(&v, "time").passed);
+    // Collateral of half the band: half the 15 points, and more than 100 mm³ fails.
+    let m = perfect();
+    let v = judge(
+        &ex.exercise,
+        &Metrics {
+            collateral_volume: m.band_volume / 2.0,
+            ..m
+        },
+    );
+    assert!((v.parts.collateral - 7.5).abs() < 1e-6);
+    assert!(!check(&v, "collateral").passed);
+    // Through the slab: deeper than 3 + 2.5 mm fails max_depth.
+    let v = judge(
+        &ex.exercise,
+        &Metrics {
+            max_depth: 0.006,
+            ..perfect()
+        },
+    );
+    assert!(!check(&v, "max_depth").passed);
+    assert!(check(&v, "max_depth").detail.contains("6.0 mm"));
+}
+
+#[test]
+fn nothing_cut_scores_no_deviation_or_depth_points_and_says_why() {
+    let ex = slab_depth();
+    let m = Metrics {
+        mean_deviation: None,
+        max_deviation: None,
+        mean_depth_error: None,
+        completion: 0.0,
+        duration: 0.0,
+        ..perfect()
+    };
+    let v = judge(&ex.exercise, &m);
+    assert_eq!(
+        (v.parts.deviation, v.parts.depth, v.parts.completion),
+        (0.0, 0.0, 0.0)
+    );
+    assert!(
+        check(&v, "mean_deviation")
+            .detail
+            .contains("nothing was cut")
+    );
+    assert!(check(&v, "time").detail.contains("never touched"));
+    assert!(!v.passed && !check(&v, "score").passed, "{}", v.score);
+}
+
+/// Rest centroid of tet `t`.
+fn centroid(ex: &LoadedExercise, t: usize) -> DVec3 {
+    ex.mesh.tets[t]
+        .iter()
+        .map(|&i| ex.mesh.rest_positions[i as usize].as_dvec3())
+        .sum::<DVec3>()
+        / 4.0
+}
+
+#[test]
+fn metrics_of_a_hand_made_cut_along_the_plan() {
+    let ex = slab_depth();
+    let n = ex.mesh.tet_count();
+    // Nothing released, no contact.
+    let none = compute_metrics(
+        &ex.exercise,
+        &ex.plan,
+        &ex.mesh,
+        &vec![false; n],
+        &[],
+        1.0 / 60.0,
+    );
+    assert_eq!(
+        (none.completion, none.released_tets, none.strokes),
+        (0.0, 0, 0)
+    );
+    assert_eq!((none.mean_deviation, none.duration), (None, 0.0));
+    // Release the top layer's tets under the plan (y = 2 cm, x 2.5–5.5 cm, the top
+    // 2 mm cell layer of the 8 mm slab): the whole plan cut, on the line, 2 mm deep.
+    let on_plan =
+        |c: DVec3| (c.y - 0.02).abs() < 0.0015 && (0.025..0.055).contains(&c.x) && c.z > 0.006;
+    let released: Vec<bool> = (0..n).map(|t| on_plan(centroid(&ex, t))).collect();
+    let m = compute_metrics(&ex.exercise, &ex.plan, &ex.mesh, &released, &[], 1.0 / 60.0);
+    assert_eq!(m.released_tets, released.iter().filter(|r| **r).count());
+    assert!(m.completion > 0.9, "completion {}", m.completion);
+    assert!(
+        m.mean_deviation.unwrap() < m.tet_edge,
+        "{:?}",
+        m.mean_deviation
+    );
+    assert!((m.max_depth - 0.002).abs() < 1e-6, "depth {}", m.max_depth);
+    assert!(
+        (m.mean_depth_error.unwrap() - 0.001).abs() < 3e-4,
+        "{:?}",
+        m.mean_depth_error
+    );
+    assert_eq!(m.collateral_volume, 0.0);
+    // Tets 1 cm to the side are collateral, volume for volume.
+    let aside =
+        |c: DVec3| (c.y - 0.03).abs() < 0.0015 && (0.025..0.035).contains(&c.x) && c.z > 0.006;
+    let extra: Vec<usize> = (0..n).filter(|&t| aside(centroid(&ex, t))).collect();
+    let mut both = released.clone();
+    extra.iter().for_each(|&t| both[t] = true);
+    let m2 = compute_metrics(&ex.exercise, &ex.plan, &ex.mesh, &both, &[], 1.0 / 60.0);
+    let volume: f64 = extra.iter().map(|&t| ex.mesh.rest_volume[t] as f64).sum();
+    assert!(!extra.is_empty());
+    assert!(
+        (m2.collateral_volume - volume).abs() < 1e-12 * volume.max(1.0),
+        "{} vs {volume}",
+        m2.collateral_volume
+    );
+}
+
+#[test]
+fn tool_figures_count_strokes_across_contact_gaps() {
+    let ex = slab_depth();
+    let n = ex.mesh.tet_count();
+    // Contact in frames 10–19 and 30–34 (a gap of 10 > 6 frames: two strokes), 2 N
+    // peak; frame 25 has a force but no contact.
+    let frames: Vec<FrameStats> = (0..40)
+        .map(|i| FrameStats {
+            frame: i,
+            sim_time: i as f64 / 60.0,
+            contact_nodes: if (10..20).contains(&i) || (30..35).contains(&i) {
+                3
+            } else {
+                0
+            },
+            tool_force: Vec3::new(
+                0.0,
+                0.0,
+                match i {
+                    15 => 2.0,
+                    25 => 0.5,
+                    10..20 | 30..35 => 1.0,
+                    _ => 0.0,
+                },
+            ),
+            ..FrameStats::default()
+        })
+        .collect();
+    let m = compute_metrics(
+        &ex.exercise,
+        &ex.plan,
+        &ex.mesh,
+        &vec![false; n],
+        &frames,
+        0.5,
+    );
+    assert_eq!(m.strokes, 2);
+    assert_eq!(m.max_force, 2.0);
+    // Mean over the 15 contact frames: (14 × 1 + 2) / 15.
+    assert!(
+        (m.mean_force - 16.0 / 15.0).abs() < 1e-9,
+        "{}",
+        m.mean_force
+    );
+    // First to last contact, frames 10..=34, 0.5 s each.
+    assert!((m.duration - 12.5).abs() < 1e-9, "{}", m.duration);
+    assert_eq!(m.force_series.len(), 40);
+}
