@@ -41,21 +41,42 @@ fn energy64(rest: &[V3; 4], x: &[V3; 4], mu: f64, lambda: f64) -> f64 {
             f[r][c] = (0..3).map(|k| ds[k][r] * inv[k][c]).sum();
         }
     }
-    let fcols = [[f[0][0], f[1][0], f[2][0]], [f[0][1], f[1][1], f[2][1]], [f[0][2], f[1][2], f[2][2]]];
+    let fcols = [
+        [f[0][0], f[1][0], f[2][0]],
+        [f[0][1], f[1][1], f[2][1]],
+        [f[0][2], f[1][2], f[2][2]],
+    ];
     let j = det(fcols);
     let ic: f64 = f.iter().flatten().map(|v| v * v).sum();
     let jmin = J_MIN as f64;
-    let l = if j > jmin { j.ln() } else { jmin.ln() + (j - jmin) / jmin };
+    let l = if j > jmin {
+        j.ln()
+    } else {
+        jmin.ln() + (j - jmin) / jmin
+    };
     let psi = 0.5 * mu * (ic - 3.0) - mu * l + 0.5 * lambda * l * l;
     psi * d.abs() / 6.0
 }
 
 fn check(x_f32: [Vec3; 4], label: &str, expect_exact: bool) {
-    let rest_f32 = [Vec3::ZERO, Vec3::new(0.01, 0.0, 0.0), Vec3::new(0.002, 0.009, 0.0), Vec3::new(0.003, 0.002, 0.011)];
-    let m = Material { youngs_modulus: 1.8e5, poisson_ratio: 0.45, density: 1040.0 };
+    let rest_f32 = [
+        Vec3::ZERO,
+        Vec3::new(0.01, 0.0, 0.0),
+        Vec3::new(0.002, 0.009, 0.0),
+        Vec3::new(0.003, 0.002, 0.011),
+    ];
+    let m = Material {
+        youngs_modulus: 1.8e5,
+        poisson_ratio: 0.45,
+        density: 1040.0,
+    };
     let lame = m.lame();
     let (mu, lambda) = (lame.mu as f64, lame.lambda as f64);
-    let dm = Mat3::from_cols(rest_f32[1] - rest_f32[0], rest_f32[2] - rest_f32[0], rest_f32[3] - rest_f32[0]);
+    let dm = Mat3::from_cols(
+        rest_f32[1] - rest_f32[0],
+        rest_f32[2] - rest_f32[0],
+        rest_f32[3] - rest_f32[0],
+    );
     let dm_inv = dm.inverse();
     let volume = dm.determinant().abs() / 6.0;
     let u: [Vec3; 4] = std::array::from_fn(|k| x_f32[k] - rest_f32[k]);
@@ -65,7 +86,10 @@ fn check(x_f32: [Vec3; 4], label: &str, expect_exact: bool) {
     let x = x_f32.map(to64);
     let e = energy64(&rest, &x, mu, lambda);
     let e32 = (volume * energy_density(&s, lame)) as f64;
-    assert!((e32 - e).abs() <= 1e-4 * e.abs() + 1e-12, "{label}: energy {e32} vs {e}");
+    assert!(
+        (e32 - e).abs() <= 1e-4 * e.abs() + 1e-12,
+        "{label}: energy {e32} vs {e}"
+    );
     let b = incise_sim::vbd::shape_gradients(&dm_inv);
     let eps = 1e-6;
     for a in 0..4 {
@@ -85,36 +109,62 @@ fn check(x_f32: [Vec3; 4], label: &str, expect_exact: bool) {
         let scale_g = g.length() as f64 + 1e-9;
         for k in 0..3 {
             let fd = (shifted(unit(k, eps)) - shifted(unit(k, -eps))) / (2.0 * eps);
-            assert!((fd - g[k] as f64).abs() < 2e-3 * scale_g, "{label}: vertex {a} grad[{k}] {} vs fd {fd}", g[k]);
+            assert!(
+                (fd - g[k] as f64).abs() < 2e-3 * scale_g,
+                "{label}: vertex {a} grad[{k}] {} vs fd {fd}",
+                g[k]
+            );
         }
         let scale_h = (0..3).map(|c| hb.col(c).length()).fold(0.0f32, f32::max) as f64;
         let eh = 1e-5;
         for r in 0..3 {
             for c in 0..3 {
                 let add = |p: [f64; 3], q: [f64; 3]| [p[0] + q[0], p[1] + q[1], p[2] + q[2]];
-                let fd = (shifted(add(unit(r, eh), unit(c, eh))) - shifted(add(unit(r, eh), unit(c, -eh)))
+                let fd = (shifted(add(unit(r, eh), unit(c, eh)))
+                    - shifted(add(unit(r, eh), unit(c, -eh)))
                     - shifted(add(unit(r, -eh), unit(c, eh)))
                     + shifted(add(unit(r, -eh), unit(c, -eh))))
                     / (4.0 * eh * eh);
                 let got = hb.col(c)[r] as f64;
                 if expect_exact {
-                    assert!((fd - got).abs() < 2e-3 * scale_h, "{label}: vertex {a} H[{r}][{c}] {got} vs fd {fd}");
+                    assert!(
+                        (fd - got).abs() < 2e-3 * scale_h,
+                        "{label}: vertex {a} H[{r}][{c}] {got} vs fd {fd}"
+                    );
                 }
             }
         }
         // The projected block is SPD in every case.
         let det = hb.determinant();
-        assert!(det > 0.0 && hb.x_axis.x > 0.0, "{label}: vertex {a} block not SPD, det {det}");
+        assert!(
+            det > 0.0 && hb.x_axis.x > 0.0,
+            "{label}: vertex {a} block not SPD, det {det}"
+        );
     }
 }
 
 #[test]
 fn gradient_and_hessian_match_finite_differences() {
-    let rest = [Vec3::ZERO, Vec3::new(0.01, 0.0, 0.0), Vec3::new(0.002, 0.009, 0.0), Vec3::new(0.003, 0.002, 0.011)];
+    let rest = [
+        Vec3::ZERO,
+        Vec3::new(0.01, 0.0, 0.0),
+        Vec3::new(0.002, 0.009, 0.0),
+        Vec3::new(0.003, 0.002, 0.011),
+    ];
     // Moderate strain (J ≈ 1.1), then large shear and stretch (J ≈ 1.6).
-    let moderate = [rest[0] + Vec3::new(0.0003, -0.0002, 0.0001), rest[1] + Vec3::new(0.001, 0.0004, -0.0002), rest[2] + Vec3::new(-0.0005, 0.0008, 0.0003), rest[3] + Vec3::new(0.0002, -0.0001, 0.0009)];
+    let moderate = [
+        rest[0] + Vec3::new(0.0003, -0.0002, 0.0001),
+        rest[1] + Vec3::new(0.001, 0.0004, -0.0002),
+        rest[2] + Vec3::new(-0.0005, 0.0008, 0.0003),
+        rest[3] + Vec3::new(0.0002, -0.0001, 0.0009),
+    ];
     check(moderate, "moderate", true);
-    let large = [rest[0], rest[1] + Vec3::new(0.01, 0.002, 0.0), rest[2] + Vec3::new(0.004, 0.002, 0.001), rest[3] + Vec3::new(-0.003, 0.001, 0.002)];
+    let large = [
+        rest[0],
+        rest[1] + Vec3::new(0.01, 0.002, 0.0),
+        rest[2] + Vec3::new(0.004, 0.002, 0.001),
+        rest[3] + Vec3::new(-0.003, 0.001, 0.002),
+    ];
     check(large, "large", true);
     // Compressed to J < J_MIN: the continued branch (L'' = 0).
     let crushed = [rest[0], rest[1], rest[2], Vec3::new(0.003, 0.002, 0.0008)];
@@ -125,7 +175,12 @@ fn gradient_and_hessian_match_finite_differences() {
 /// (the gradient is still exact).
 #[test]
 fn projected_block_is_spd_at_large_dilation() {
-    let rest = [Vec3::ZERO, Vec3::new(0.01, 0.0, 0.0), Vec3::new(0.002, 0.009, 0.0), Vec3::new(0.003, 0.002, 0.011)];
+    let rest = [
+        Vec3::ZERO,
+        Vec3::new(0.01, 0.0, 0.0),
+        Vec3::new(0.002, 0.009, 0.0),
+        Vec3::new(0.003, 0.002, 0.011),
+    ];
     let grown = rest.map(|p| p * 1.65);
     check(grown, "dilated", false);
 }

@@ -36,10 +36,17 @@ fn rest_stays_exactly_at_rest() {
             for _ in 0..20 {
                 s.step_frame().unwrap();
             }
-            let moved = s.displacements().iter().filter(|u| u.length() != 0.0).count();
+            let moved = s
+                .displacements()
+                .iter()
+                .filter(|u| u.length() != 0.0)
+                .count();
             assert_eq!(moved, 0, "ν = {nu}, {guess:?}: {moved} nodes moved");
             assert_eq!(s.elastic_energy(), 0.0, "ν = {nu}, {guess:?}");
-            assert!(s.von_mises().iter().all(|&v| v == 0.0), "ν = {nu}, {guess:?}");
+            assert!(
+                s.von_mises().iter().all(|&v| v == 0.0),
+                "ν = {nu}, {guess:?}"
+            );
         }
     }
 }

@@ -40,7 +40,9 @@ pub fn greedy_vertex_colors(node_count: usize, tets: &[[u32; 4]]) -> (Vec<u32>, 
                 }
             }
         }
-        let c = (0..).find(|&c| used.get(c).is_none_or(|&s| s != stamp)).unwrap_or(0);
+        let c = (0..)
+            .find(|&c| used.get(c).is_none_or(|&s| s != stamp))
+            .unwrap_or(0);
         color[node] = c as u32;
         ncolors = ncolors.max(c + 1);
     }

@@ -325,7 +325,12 @@ impl VbdSolver {
                 frame: self.frame,
             });
         }
-        for ((x, r), u) in self.x.iter_mut().zip(&self.mesh.rest_positions).zip(&self.u) {
+        for ((x, r), u) in self
+            .x
+            .iter_mut()
+            .zip(&self.mesh.rest_positions)
+            .zip(&self.u)
+        {
             *x = *r + *u;
         }
         Ok(VbdFrameStats {

@@ -56,14 +56,21 @@ pub fn end_nodes(mesh: &TetMesh, at: f32, side: f32) -> Vec<u32> {
     (0..mesh.node_count() as u32)
         .filter(|&i| {
             let x = mesh.rest_positions[i as usize].x;
-            if side < 0.0 { x <= at + 1e-6 } else { x >= at - 1e-6 }
+            if side < 0.0 {
+                x <= at + 1e-6
+            } else {
+                x >= at - 1e-6
+            }
         })
         .collect()
 }
 
 /// Tip sag: −(mean z displacement) of the nodes of the free end face, m.
 pub fn tip_sag(rest: &[Vec3], x: &[Vec3], tip: &[u32]) -> f32 {
-    let s: f32 = tip.iter().map(|&i| rest[i as usize].z - x[i as usize].z).sum();
+    let s: f32 = tip
+        .iter()
+        .map(|&i| rest[i as usize].z - x[i as usize].z)
+        .sum();
     s / tip.len() as f32
 }
 
@@ -78,12 +85,22 @@ pub fn pull_grab(mesh: &TetMesh) -> Grab {
 }
 
 /// VBD settings for a scene.
-pub fn vbd_params(hz: f32, substeps: u32, iterations: u32, gravity: bool, damping: f32) -> VbdParams {
+pub fn vbd_params(
+    hz: f32,
+    substeps: u32,
+    iterations: u32,
+    gravity: bool,
+    damping: f32,
+) -> VbdParams {
     VbdParams {
         frame_dt: 1.0 / hz,
         substeps,
         iterations,
-        gravity: if gravity { Vec3::new(0.0, 0.0, -9.81) } else { Vec3::ZERO },
+        gravity: if gravity {
+            Vec3::new(0.0, 0.0, -9.81)
+        } else {
+            Vec3::ZERO
+        },
         damping,
         ..VbdParams::default()
     }
