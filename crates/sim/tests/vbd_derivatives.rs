@@ -13,6 +13,7 @@ use incise_sim::xpbd::{J_MIN, Strain, displacement_gradient};
 type V3 = [f64; 3];
 
 /// f64 energy `V Ψ` of a tet with rest corners `rest` and deformed corners `x`.
+#[allow(clippy::needless_range_loop)] // index loops over 3×3 matrices read as the formulas
 fn energy64(rest: &[V3; 4], x: &[V3; 4], mu: f64, lambda: f64) -> f64 {
     let sub = |a: V3, b: V3| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let cols = |p: &[V3; 4]| [sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0])];
