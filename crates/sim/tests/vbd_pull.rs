@@ -12,6 +12,12 @@ fn pull_to_100_percent_matches_xpbd_200() {
     let hz = 72.0;
     let frames = (PULL / PULL_SPEED * hz).round() as u32;
     let mut v = vbd_pull(vbd_params(hz, 2, 1, false, 1.0));
+    let beam = vbd_cantilever(vbd_params(hz, 1, 1, true, 1.0)).0;
+    println!(
+        "vertex colours: bar {}, cantilever {}",
+        v.color_count(),
+        beam.color_count()
+    );
     let mut x = xpbd_pull(hz, 200);
     for _ in 0..frames {
         v.step_frame().expect("VBD stays finite");
