@@ -13,7 +13,8 @@
 //! vertices of one colour in parallel (§3.4). Optional Rayleigh damping (§3.5),
 //! initial guess (§3.7), Chebyshev acceleration (§3.8). The state is the displacement
 //! `u = x − X`, as in the XPBD solver, so rest is exactly force-free in f32.
-//! Section numbers are those of arXiv:2403.06321; the equations are restated here.
+//! The equations are restated here; the § numbers refer to arXiv:2403.06321 as recalled
+//! (the paper's text was not at hand to check them or its equation numbers).
 
 use std::time::Instant;
 
