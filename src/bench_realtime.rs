@@ -43,7 +43,13 @@ pub struct RealtimeResult {
 }
 
 /// Time `frames` frames of `scene` on `device` and print a table row or the JSON.
-pub fn run(scene: &Path, device: DeviceChoice, threads: Option<usize>, frames: u32, json: bool) -> Result<()> {
+pub fn run(
+    scene: &Path,
+    device: DeviceChoice,
+    threads: Option<usize>,
+    frames: u32,
+    json: bool,
+) -> Result<()> {
     let r = measure(scene, device, threads, frames)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&r)?);
@@ -68,7 +74,12 @@ pub fn run(scene: &Path, device: DeviceChoice, threads: Option<usize>, frames: u
 }
 
 /// The measurement behind [`run`].
-pub fn measure(scene_path: &Path, device: DeviceChoice, threads: Option<usize>, frames: u32) -> Result<RealtimeResult> {
+pub fn measure(
+    scene_path: &Path,
+    device: DeviceChoice,
+    threads: Option<usize>,
+    frames: u32,
+) -> Result<RealtimeResult> {
     let scene = crate::scene::load_scene(scene_path)?;
     let built = crate::scene::build_scene(&scene, scene_path, threads)?;
     let (tets, substeps, frame_dt) = (
@@ -79,7 +90,8 @@ pub fn measure(scene_path: &Path, device: DeviceChoice, threads: Option<usize>, 
     let stroke = built.tool.as_ref().and_then(|t| t.stroke.clone());
     let mut body = Body::place(built.solver, device, |m| eprintln!("note: {m}"))
         .with_context(|| format!("{}: placing the body", scene_path.display()))?;
-    let (mut frame, mut solve, mut checks, mut stress) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut frame, mut solve, mut checks, mut stress) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for f in 0..frames.max(1) as u64 + 2 {
         if let Some(s) = &stroke {
             body.move_tool(s.pose_at((f + 1) as f64 * frame_dt as f64));

@@ -7,7 +7,9 @@ use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
 use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
 use incise::screenshots::ImageSize;
-use incise::{bench, bench_realtime, bench_render, compare, exercise, experiment, mesh_cmd, screenshots};
+use incise::{
+    bench, bench_realtime, bench_render, compare, exercise, experiment, mesh_cmd, screenshots,
+};
 
 /// The scene opened when none is named.
 const DEFAULT_SCENE: &str = "config/intestine_pull.ron";

@@ -21,6 +21,7 @@ pub mod rheology;
 pub mod selection;
 pub mod skin;
 pub mod stress;
+pub mod vbd;
 pub mod xpbd;
 
 pub use error::MeshError;

@@ -95,7 +95,8 @@ mod tests {
                 - f[1][0] * (f[0][1] * f[2][2] - f[2][1] * f[0][2])
                 + f[2][0] * (f[0][1] * f[1][2] - f[1][1] * f[0][2])
         };
-        let energies: [(ConstraintPair, Box<dyn Fn(&[[f64; 3]; 3]) -> f64>); 2] = [
+        type Energy = Box<dyn Fn(&[[f64; 3]; 3]) -> f64>;
+        let energies: [(ConstraintPair, Energy); 2] = [
             (
                 ConstraintPair::RestFree,
                 Box::new(move |f| {
@@ -127,6 +128,7 @@ mod tests {
                 }
             }
             let j = det(&cols);
+            #[allow(clippy::needless_range_loop)] // r, c index two matrices at once
             for r in 0..3 {
                 for c in 0..3 {
                     let expect: f64 = (0..3).map(|k| p[k][r] * cols[k][c]).sum::<f64>() / j;
