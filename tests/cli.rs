@@ -213,7 +213,7 @@ fn shipped_scenes_build() {
 
 /// Every shipped scene (each `config/*.ron` but the preset files) runs three frames from
 /// the command line and completes with its mesh and frames in report.json; the folder
-/// holds the nine scenes the README lists.
+/// holds the ten scenes the README lists.
 #[test]
 fn every_shipped_scene_runs() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
@@ -227,7 +227,7 @@ fn every_shipped_scene_runs() {
         })
         .collect();
     scenes.sort();
-    assert_eq!(scenes.len(), 9, "{scenes:?}");
+    assert_eq!(scenes.len(), 10, "{scenes:?}");
     for scene in &scenes {
         let name = scene.file_stem().unwrap().to_str().unwrap();
         let out = dir.join(name);

@@ -173,11 +173,12 @@ fn ctrl_c_ends_an_xr_session_cleanly() {
     ctrl_c(&child);
     let o = child.wait_with_output().unwrap();
     let err = text(&o.stderr);
-    assert!(o.status.success(), "{err}");
+    // An interrupt says so and uses the interrupted exit code, like `incise run` (issue 19).
+    assert_eq!(o.status.code(), Some(130), "{err}");
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("xr_report.json")).unwrap())
             .unwrap();
-    assert_eq!(r["exit"], "Exited", "{r}");
+    assert_eq!(r["exit"], "Interrupted", "{r}");
     let frames = r["frames"].as_u64().unwrap();
     assert!(frames < 60 * 72, "stopped early: {frames} frames");
     assert!(out.join("frames.csv").exists());

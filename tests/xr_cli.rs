@@ -218,8 +218,9 @@ fn with_the_trigger_released_the_blade_pushes_but_does_not_cut() {
     assert_eq!(r["exit"], "Exited");
     assert_eq!(r["solver_resets"].as_u64(), Some(0), "{r}");
     assert_eq!(r["released_tets"].as_u64(), Some(0), "{r}");
+    // 0.046 N with the rest-free pair (0.05+ with the seed's softer γ-shifted pair).
     assert!(
-        r["max_tool_force"].as_f64().unwrap() > 0.05,
+        r["max_tool_force"].as_f64().unwrap() > 0.03,
         "the dull blade still pushes: {r}"
     );
     assert_eq!(
@@ -393,7 +394,8 @@ fn an_exercise_in_the_headset_is_scored_on_a_and_shows_its_card() {
     let history = std::fs::read_to_string(out.join("history.jsonl")).unwrap();
     assert_eq!(history.lines().count(), 1);
 
-    // The plan is drawn while cutting (violet ink, sRGB #6A1B9A-ish) and the card only
+    // The plan is drawn while cutting (violet ink, sRGB #6A1B9A-ish: blue and red well
+    // above green, unlike the pink skin, the red cut and the grey tool) and the card only
     // after A.
     let before = RgbaImage::load_png(&out.join("eye_left_00036.png")).unwrap();
     let after = RgbaImage::load_png(&out.join("eye_left_00144.png")).unwrap();
@@ -401,13 +403,13 @@ fn an_exercise_in_the_headset_is_scored_on_a_and_shows_its_card() {
         (0..img.height)
             .flat_map(|y| (0..img.width).map(move |x| (x, y)))
             .filter(|&(x, y)| {
-                let p = img.get(x, y);
-                p[2] > 100 && p[0] > 60 && p[1] < 60 && p[2] > p[0]
+                let p = img.get(x, y).map(i32::from);
+                p[2] > p[1] + 30 && p[0] > p[1] + 10
             })
             .count()
     };
     assert!(
-        violet(&before) > 5,
+        violet(&before) > 10,
         "plan drawn: {} violet pixels",
         violet(&before)
     );

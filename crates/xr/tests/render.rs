@@ -28,7 +28,8 @@ use incise_xr::{
 
 const SIZE: (u32, u32) = (320, 240);
 /// The bar's cut threshold, Pa.
-const BAR_THRESHOLD: f32 = 6e3;
+// Cauchy von Mises (twice the seed's eq. 3 value, 6 kPa, at small strain).
+const BAR_THRESHOLD: f32 = 12e3;
 
 /// Compare with `tests/golden/NAME.png`; on failure write the image and a diff beside the
 /// test binaries and fail naming them.
