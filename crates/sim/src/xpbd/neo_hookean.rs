@@ -127,9 +127,21 @@ fn project_coupled(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
     }
     let c_d = norm;
     let g_d = vertex_gradients(f * (1.0 / norm), &t.dm_inv);
-    let a = weighted_dot(w, &g_h, &g_h) + t.alpha_h;
-    let b = weighted_dot(w, &g_h, &g_d);
-    let d = weighted_dot(w, &g_d, &g_d) + t.alpha_d;
+    apply_pair(x, w, (&g_h, c_h, t.alpha_h), (&g_d, c_d, t.alpha_d))
+}
+
+/// One constraint of a pair: vertex gradients, value `C`, compliance `α̃`.
+pub(super) type PairTerm<'a> = (&'a [Vec3; 4], f32, f32);
+
+/// The 2×2 block XPBD update of two constraints (volume `h`, shape `d`), λ reset each
+/// substep: `[S_HH+α̃_H, S_HD; S_HD, S_DD+α̃_D] Δλ = −C`, `x_i += w_i (∇_i C_H Δλ_H +
+/// ∇_i C_D Δλ_D)`; returns `Δλ_H`.
+// PHYSICS.md §1.2, XPBD update (block form of Δλ = (−C − α̃λ)/(Σ w|∇C|² + α̃) with λ = 0).
+pub(super) fn apply_pair(x: &mut [Vec3; 4], w: &[f32; 4], h: PairTerm<'_>, d: PairTerm<'_>) -> f32 {
+    let ((g_h, c_h, alpha_h), (g_d, c_d, alpha_d)) = (h, d);
+    let a = weighted_dot(w, g_h, g_h) + alpha_h;
+    let b = weighted_dot(w, g_h, g_d);
+    let d = weighted_dot(w, g_d, g_d) + alpha_d;
     // Scale the system to O(1) before the determinant so tiny stiff tets stay in f32 range.
     let s = 1.0 / (a + d);
     let (a, b, d) = (a * s, b * s, d * s);

@@ -18,7 +18,7 @@
 
 use glam::{Mat3, Vec3};
 
-use super::neo_hookean::{TetProjection, TetTerms, apply_scalar, vertex_gradients, weighted_dot};
+use super::neo_hookean::{TetProjection, TetTerms, apply_pair, apply_scalar, vertex_gradients};
 use super::strain::{Strain, displacement_gradient, log1p_excess};
 
 /// Below this `J`, `ln J` is continued linearly (value and slope match at `J_MIN`).
@@ -87,9 +87,8 @@ pub fn project_rest_free(
     }
 }
 
-/// The 2×2 block XPBD step `[S_HH+α̃_H, S_HD; S_HD, S_DD+α̃_D] Δλ = −C` (λ reset each
-/// substep); one scalar step where only one constraint applies (at rest: `C_D` has no
-/// direction; ν = 0: λ = 0, no volume constraint).
+/// The 2×2 block XPBD step of both constraints ([`apply_pair`]); one scalar step where only
+/// one applies (at rest: `C_D` has no direction; ν = 0: λ = 0, no volume constraint).
 // PHYSICS.md §1.2, XPBD update (block form, λ = 0 at the start of the substep).
 fn project_coupled(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
     let s = Strain::of(displacement_gradient(x, &t.dm_inv));
@@ -109,23 +108,7 @@ fn project_coupled(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
         apply_scalar(x, w, &g_d, c_d, t.alpha_d);
         return 0.0;
     }
-    let a = weighted_dot(w, &g_h, &g_h) + t.alpha_h;
-    let b = weighted_dot(w, &g_h, &g_d);
-    let d = weighted_dot(w, &g_d, &g_d) + t.alpha_d;
-    // Scale the system to O(1) before the determinant so tiny stiff tets stay in range.
-    let sc = 1.0 / (a + d);
-    let (a, b, d) = (a * sc, b * sc, d * sc);
-    let det = a * d - b * b;
-    if det.is_nan() || det <= 0.0 {
-        return 0.0;
-    }
-    let (r1, r2) = (-c_h * sc, -c_d * sc);
-    let dl_h = (r1 * d - b * r2) / det;
-    let dl_d = (a * r2 - b * r1) / det;
-    for i in 0..4 {
-        x[i] += w[i] * (g_h[i] * dl_h + g_d[i] * dl_d);
-    }
-    dl_h
+    apply_pair(x, w, (&g_h, c_h, t.alpha_h), (&g_d, c_d, t.alpha_d))
 }
 
 /// Volume, then shape, each a scalar XPBD step.
