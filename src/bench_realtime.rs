@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use crate::body::{Body, DeviceChoice};
+use crate::soak::percentile;
 
 /// The realtime figures of one device.
 #[derive(Debug, Clone, Serialize)]
@@ -107,8 +108,11 @@ pub fn measure(
             stress.push(st.stress_ms);
         }
     }
-    let median = |v: &mut Vec<f64>| quantile(v, 0.5);
-    let frame_ms_median = median(&mut frame.clone());
+    for v in [&mut frame, &mut solve, &mut checks, &mut stress] {
+        v.sort_by(f64::total_cmp);
+    }
+    let median = |v: &[f64]| percentile(v, 0.5);
+    let frame_ms_median = median(&frame);
     Ok(RealtimeResult {
         scene: scene_path.display().to_string(),
         device: body.device(),
@@ -117,20 +121,11 @@ pub fn measure(
         frame_dt,
         frames: frame.len(),
         frame_ms_median,
-        frame_ms_p99: quantile(&mut frame, 0.99),
-        substeps_ms_median: median(&mut solve),
-        release_checks_ms_median: median(&mut checks),
-        stress_ms_median: median(&mut stress),
+        frame_ms_p99: percentile(&frame, 0.99),
+        substeps_ms_median: median(&solve),
+        release_checks_ms_median: median(&checks),
+        stress_ms_median: median(&stress),
         frames_per_second: 1e3 / frame_ms_median,
         real_time: frame_ms_median <= frame_dt as f64 * 1e3,
     })
-}
-
-/// The `q` quantile (nearest rank) of `v`.
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q).round() as usize]
 }

@@ -157,14 +157,7 @@ fn free_uniaxial_tension_matches_the_closed_form() {
         let m = soft(20e3, 0.45);
         let mut s = solver_at_kappa(mesh, m, params, 0.02);
         let rest = s.mesh().rest_positions.clone();
-        let end = |x: f32, n: f32| {
-            NodeSelection::PlaneSide {
-                point: Vec3::new(x, 0.0, 0.0),
-                normal: Vec3::X * n,
-            }
-            .select(&rest)
-            .unwrap()
-        };
+        let end = |x: f32, n: f32| plane_side(&rest, x, n);
         s.pin(&end(1e-5, -1.0));
         s.add_grab(Grab {
             nodes: end(len - 1e-5, 1.0),
@@ -242,14 +235,7 @@ fn release_does_not_depend_on_the_frame_rate() {
         };
         let mut s = Solver::new(mesh, soft(10e3, 0.45), params).unwrap();
         let rest = s.mesh().rest_positions.clone();
-        let side = |x: f32, n: f32| {
-            NodeSelection::PlaneSide {
-                point: Vec3::new(x, 0.0, 0.0),
-                normal: Vec3::X * n,
-            }
-            .select(&rest)
-            .unwrap()
-        };
+        let side = |x: f32, n: f32| plane_side(&rest, x, n);
         s.pin(&side(1e-4, -1.0));
         s.add_grab(Grab {
             nodes: side(0.08 - 1e-4, 1.0),
@@ -274,4 +260,14 @@ fn release_does_not_depend_on_the_frame_rate() {
         (*hi - *lo) as f32 <= 0.1 * *lo as f32,
         "released counts differ by more than 10 %: {fixed:?}"
     );
+}
+
+/// Nodes on the `n` side (±1 along x) of the plane x = `x`.
+fn plane_side(rest: &[Vec3], x: f32, n: f32) -> Vec<u32> {
+    NodeSelection::PlaneSide {
+        point: Vec3::new(x, 0.0, 0.0),
+        normal: Vec3::X * n,
+    }
+    .select(rest)
+    .unwrap()
 }
