@@ -7,6 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use incise_sim::xpbd::CpuKernel;
 use serde::Serialize;
 
 use crate::body::{Body, DeviceChoice};
@@ -19,6 +20,8 @@ pub struct RealtimeResult {
     pub scene: String,
     /// "cpu (N threads)" or the GPU adapter.
     pub device: String,
+    /// The CPU projection kernel ("Lanes" or "Scalar"; the GPU ignores it).
+    pub cpu_kernel: String,
     /// Tets.
     pub tets: usize,
     /// Substeps per frame (the scene's).
@@ -43,23 +46,27 @@ pub struct RealtimeResult {
     pub real_time: bool,
 }
 
+/// CPU threads (default: the scene's) and projection kernel (default: the scene's).
+pub type CpuChoice = (Option<usize>, Option<CpuKernel>);
+
 /// Time `frames` frames of `scene` on `device` and print a table row or the JSON.
 pub fn run(
     scene: &Path,
     device: DeviceChoice,
-    threads: Option<usize>,
+    cpu: CpuChoice,
     frames: u32,
     json: bool,
 ) -> Result<()> {
-    let r = measure(scene, device, threads, frames)?;
+    let r = measure(scene, device, cpu, frames)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
         println!(
-            "{} on {}: {} tets, {} substeps/frame: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
+            "{} on {} ({} kernel): {} tets, {} substeps/frame: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
              substeps {:.1} ms, release checks {:.1} ms, stress+guards {:.1} ms{}",
             r.scene,
             r.device,
+            r.cpu_kernel,
             r.tets,
             r.substeps,
             r.frame_ms_median,
@@ -78,11 +85,15 @@ pub fn run(
 pub fn measure(
     scene_path: &Path,
     device: DeviceChoice,
-    threads: Option<usize>,
+    (threads, kernel): CpuChoice,
     frames: u32,
 ) -> Result<RealtimeResult> {
-    let scene = crate::scene::load_scene(scene_path)?;
+    let mut scene = crate::scene::load_scene(scene_path)?;
+    if let Some(k) = kernel {
+        scene.solver.cpu_kernel = k;
+    }
     let built = crate::scene::build_scene(&scene, scene_path, threads)?;
+    let cpu_kernel = format!("{:?}", built.solver.params().cpu_kernel);
     let (tets, substeps, frame_dt) = (
         built.solver.mesh().tet_count(),
         built.solver.params().substeps,
@@ -116,6 +127,7 @@ pub fn measure(
     Ok(RealtimeResult {
         scene: scene_path.display().to_string(),
         device: body.device(),
+        cpu_kernel,
         tets,
         substeps,
         frame_dt,

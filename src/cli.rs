@@ -196,6 +196,9 @@ pub enum Command {
         /// CPU solver threads of the `realtime` target (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// CPU projection kernel of the `realtime` target (default: the scene's).
+        #[arg(long, value_enum)]
+        cpu_kernel: Option<KernelChoice>,
     },
     /// Endurance run: cut a scalpel scene, reset, cut again for a wall-clock duration;
     /// fails (exit 1) if memory grows > 5 %, file descriptors leak or a cut differs.
@@ -347,6 +350,24 @@ pub enum GenKind {
     Block,
     /// 20 cm × 2 cm × 2 cm beam, 40 × 4 × 4 cells.
     Beam,
+}
+
+/// Which CPU kernel projects the tets (`incise bench realtime --cpu-kernel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum KernelChoice {
+    /// Eight tets at once in SIMD lanes (the default).
+    Lanes,
+    /// One tet at a time (the reference).
+    Scalar,
+}
+
+impl From<KernelChoice> for incise_sim::xpbd::CpuKernel {
+    fn from(k: KernelChoice) -> Self {
+        match k {
+            KernelChoice::Lanes => incise_sim::xpbd::CpuKernel::Lanes,
+            KernelChoice::Scalar => incise_sim::xpbd::CpuKernel::Scalar,
+        }
+    }
 }
 
 /// What `incise bench` times.

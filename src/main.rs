@@ -175,8 +175,15 @@ fn main() -> ExitCode {
             device,
             scene,
             threads,
+            cpu_kernel,
             ..
-        } => bench_realtime::run(&scene, device, threads, frames, json),
+        } => bench_realtime::run(
+            &scene,
+            device,
+            (threads, cpu_kernel.map(Into::into)),
+            frames,
+            json,
+        ),
         Command::Bench {
             target: BenchTarget::Solver,
             json,

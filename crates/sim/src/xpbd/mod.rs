@@ -2,10 +2,13 @@
 
 mod coloring;
 mod frame;
+mod lane_pass;
+mod lanes;
 mod neo_hookean;
 mod params;
 mod release_schedule;
 mod rest_free;
+mod rest_free_lanes;
 mod shared_nodes;
 mod solver;
 mod stability;
@@ -16,7 +19,7 @@ pub use frame::FrameStats;
 pub use neo_hookean::{
     ConstraintPair, TetProjection, TetTerms, deformation_gradient, det_gradient, project_tet,
 };
-pub use params::{DEFAULT_RELEASE_INTERVAL, SolverError, SolverParams};
+pub use params::{CpuKernel, DEFAULT_RELEASE_INTERVAL, SolverError, SolverParams};
 pub use release_schedule::release_checks;
 pub use rest_free::{J_MIN, log_volume, shape_constraint, shape_energy, volume_constraint};
 pub use solver::{NodeKind, Solver};

@@ -11,6 +11,17 @@ use crate::stress::StressMeasure;
 /// Default interval of the release check in simulation time, s (240 Hz).
 pub const DEFAULT_RELEASE_INTERVAL: f32 = 1.0 / 240.0;
 
+/// How the CPU solver evaluates the tet projections.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum CpuKernel {
+    /// Eight tets of a colour at once in SIMD lanes, for the rest-free coupled pair (the
+    /// other pairs and modes run scalar); matches `Scalar` to rounding (tested).
+    #[default]
+    Lanes,
+    /// One tet at a time: the reference the lanes and the GPU are tested against.
+    Scalar,
+}
+
 /// Settings of the XPBD small-steps solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -40,6 +51,9 @@ pub struct SolverParams {
     pub release_interval: Option<f32>,
     /// Worker threads for the coloured projection: 0 = all cores, 1 = serial.
     pub threads: usize,
+    /// How the CPU projects the rest-free coupled pair: `Lanes` (default, eight tets at
+    /// once in SIMD lanes) or `Scalar` (the readable reference, one tet at a time).
+    pub cpu_kernel: CpuKernel,
     /// von Mises stress above which a tet is released, Pa; `None` disables cutting.
     pub release_threshold: Option<f32>,
     /// Where the stress criterion may release tets: `Anywhere` (tearing) or
@@ -62,6 +76,7 @@ impl Default for SolverParams {
             stress: StressMeasure::Cauchy,
             release_interval: Some(DEFAULT_RELEASE_INTERVAL),
             threads: 0,
+            cpu_kernel: CpuKernel::Lanes,
             release_threshold: None,
             cut_zone: CutZone::Anywhere,
             max_inverted_frames: 30,

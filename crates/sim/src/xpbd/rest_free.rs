@@ -25,7 +25,7 @@ use super::strain::{Strain, displacement_gradient, log1p_excess};
 pub const J_MIN: f32 = 0.1;
 
 /// Below this `C_D` (a strain of ~1e-10) the shape constraint has no usable direction.
-const MIN_SHAPE: f32 = 1e-10;
+pub(super) const MIN_SHAPE: f32 = 1e-10;
 
 /// `L(J) = ln J` (linear continuation below [`J_MIN`]) and `L'(J)`.
 #[inline]

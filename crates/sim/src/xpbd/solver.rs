@@ -8,13 +8,14 @@ use glam::{Mat3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::coloring::greedy_tet_colors;
+use super::lane_pass;
 use super::neo_hookean::{
-    ConstraintPair, TetTerms, deformation_gradient_from_displacement, project_tet,
+    ConstraintPair, TetProjection, TetTerms, deformation_gradient_from_displacement, project_tet,
 };
 use super::release_schedule::release_checks;
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
-use super::{FrameStats, SolverError, SolverParams};
+use super::{CpuKernel, FrameStats, SolverError, SolverParams};
 use crate::contact::{ContactTool, CutZone, ToolMotion, ToolPose, project_node};
 use crate::cutting::{CutState, ReleaseEvent};
 use crate::grab::Grab;
@@ -549,6 +550,24 @@ impl Solver {
         };
         let slots = &self.slots[range.clone()];
         let lambdas = &mut self.lambda_h[range];
+        let lanes = self.params.cpu_kernel == CpuKernel::Lanes
+            && pair == ConstraintPair::RestFree
+            && mode == TetProjection::Coupled;
+        if lanes {
+            let run = |(s, l): (&[TetSlot], &mut [f32])| {
+                // SAFETY: tets of one colour share no node, and each run is one task's.
+                unsafe { lane_pass::project_run(s, l, &nodes, inv_mass) }
+            };
+            if parallel && slots.len() > CHUNK {
+                slots
+                    .par_chunks(CHUNK)
+                    .zip(lambdas.par_chunks_mut(CHUNK))
+                    .for_each(run);
+            } else {
+                run((slots, lambdas));
+            }
+            return;
+        }
         if parallel && slots.len() > CHUNK {
             slots
                 .par_iter()

@@ -11,7 +11,7 @@ use glam::Mat3;
 use crate::mesh::shape_matrix;
 
 /// Below this `|J − 1|`, `x − ln(1 + x)` is evaluated by its series.
-const SERIES_LIMIT: f32 = 0.1;
+pub(super) const SERIES_LIMIT: f32 = 0.1;
 
 /// `H = Du Dm⁻¹` from the four nodes' displacements.
 // PHYSICS.md §1.2, F = Ds Dm^-1 = I + Du Dm^-1.

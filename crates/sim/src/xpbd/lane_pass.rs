@@ -1,0 +1,71 @@
+//! One colour's tets projected eight at a time ([`super::rest_free_lanes`]): gather the
+//! tets' nodes and terms into lanes, project, scatter the live ones back.
+
+use glam::{Mat3, Vec3};
+
+use super::lanes::{L, LANES, M3, V3};
+use super::rest_free_lanes::{TetLanes, project_rest_free_lanes};
+use super::shared_nodes::SharedNodes;
+use super::solver::TetSlot;
+
+/// Project `slots` (tets of one colour, at most [`LANES`]) and store their volume
+/// multipliers in `lambdas`; tets that are not live are left as they are.
+///
+/// # Safety
+/// No other thread may touch these tets' nodes during the call (colouring).
+#[inline]
+pub(super) unsafe fn project_block(
+    slots: &[TetSlot],
+    lambdas: &mut [f32],
+    nodes: &SharedNodes,
+    inv_mass: &[f32],
+) {
+    debug_assert!(slots.len() <= LANES);
+    let mut u = [[Vec3::ZERO; LANES]; 4];
+    let mut w = [[0.0f32; LANES]; 4];
+    let mut dm_inv = [Mat3::IDENTITY; LANES];
+    let (mut alpha_h, mut alpha_d) = ([1.0f32; LANES], [1.0f32; LANES]);
+    let mut live = [0.0f32; LANES];
+    for (k, s) in slots.iter().enumerate().filter(|(_, s)| s.live) {
+        for j in 0..4 {
+            // SAFETY: the caller's contract.
+            u[j][k] = unsafe { nodes.get(s.nodes[j]) };
+            w[j][k] = inv_mass[s.nodes[j] as usize];
+        }
+        dm_inv[k] = s.terms.dm_inv;
+        (alpha_h[k], alpha_d[k]) = (s.terms.alpha_h, s.terms.alpha_d);
+        live[k] = f32::from_bits(u32::MAX);
+    }
+    let mut lanes = TetLanes {
+        u: u.map(|n| V3::gather(&n)),
+        w: w.map(L::new),
+        dm_inv: M3::gather(&dm_inv),
+        alpha_h: L::new(alpha_h),
+        alpha_d: L::new(alpha_d),
+        live: L::new(live),
+    };
+    let dl_h = project_rest_free_lanes(&mut lanes).to_array();
+    for (k, s) in slots.iter().enumerate().filter(|(_, s)| s.live) {
+        for j in 0..4 {
+            // SAFETY: the caller's contract.
+            unsafe { nodes.set(s.nodes[j], lanes.u[j].lane(k)) };
+        }
+        lambdas[k] = dl_h[k];
+    }
+}
+
+/// Project a run of one colour's slots, block by block.
+///
+/// # Safety
+/// As [`project_block`].
+pub(super) unsafe fn project_run(
+    slots: &[TetSlot],
+    lambdas: &mut [f32],
+    nodes: &SharedNodes,
+    inv_mass: &[f32],
+) {
+    for (s, l) in slots.chunks(LANES).zip(lambdas.chunks_mut(LANES)) {
+        // SAFETY: the caller's contract.
+        unsafe { project_block(s, l, nodes, inv_mass) };
+    }
+}

@@ -1,0 +1,301 @@
+//! Eight-lane 3-vectors and 3×3 matrices (`wide::f32x8`): the algebra of the batched tet
+//! projection ([`super::rest_free_lanes`]), each lane one tet. The operations mirror
+//! glam's `Vec3`/`Mat3` (column-major, the same operation order) so that a lane computes
+//! what the scalar reference computes, up to the rounding of `ln`.
+
+use std::ops::{Add, Mul, Neg, Sub};
+
+use wide::f32x8;
+
+/// Number of tets projected together.
+pub const LANES: usize = 8;
+
+/// One `f32` per lane.
+pub type L = f32x8;
+
+/// A 3-vector per lane.
+#[derive(Debug, Clone, Copy)]
+pub struct V3 {
+    /// x components.
+    pub x: L,
+    /// y components.
+    pub y: L,
+    /// z components.
+    pub z: L,
+}
+
+impl V3 {
+    /// The zero vector in every lane.
+    pub const ZERO: V3 = V3 {
+        x: L::ZERO,
+        y: L::ZERO,
+        z: L::ZERO,
+    };
+
+    /// Lane `k` of `v` is `v[k]`.
+    #[inline]
+    pub fn gather(v: &[glam::Vec3; LANES]) -> V3 {
+        V3 {
+            x: L::new(v.map(|p| p.x)),
+            y: L::new(v.map(|p| p.y)),
+            z: L::new(v.map(|p| p.z)),
+        }
+    }
+
+    /// The vector of lane `k`.
+    #[inline]
+    pub fn lane(&self, k: usize) -> glam::Vec3 {
+        glam::Vec3::new(
+            self.x.as_array()[k],
+            self.y.as_array()[k],
+            self.z.as_array()[k],
+        )
+    }
+
+    /// Dot product per lane.
+    #[inline]
+    pub fn dot(self, o: V3) -> L {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// Squared length per lane.
+    #[inline]
+    pub fn length_squared(self) -> L {
+        self.dot(self)
+    }
+
+    /// Cross product per lane.
+    #[inline]
+    pub fn cross(self, o: V3) -> V3 {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+}
+
+impl Add for V3 {
+    type Output = V3;
+    #[inline]
+    fn add(self, o: V3) -> V3 {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+impl Sub for V3 {
+    type Output = V3;
+    #[inline]
+    fn sub(self, o: V3) -> V3 {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl Neg for V3 {
+    type Output = V3;
+    #[inline]
+    fn neg(self) -> V3 {
+        V3 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
+    }
+}
+
+impl Mul<L> for V3 {
+    type Output = V3;
+    #[inline]
+    fn mul(self, s: L) -> V3 {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+}
+
+/// A 3×3 matrix per lane, by columns.
+#[derive(Debug, Clone, Copy)]
+pub struct M3 {
+    /// First column.
+    pub c0: V3,
+    /// Second column.
+    pub c1: V3,
+    /// Third column.
+    pub c2: V3,
+}
+
+impl M3 {
+    /// `s · I` per lane.
+    #[inline]
+    pub fn diagonal(s: L) -> M3 {
+        let z = L::ZERO;
+        M3 {
+            c0: V3 { x: s, y: z, z },
+            c1: V3 { x: z, y: s, z },
+            c2: V3 { x: z, y: z, z: s },
+        }
+    }
+
+    /// Lane `k` of the result is `m[k]`.
+    #[inline]
+    pub fn gather(m: &[glam::Mat3; LANES]) -> M3 {
+        M3 {
+            c0: V3::gather(&m.map(|a| a.x_axis)),
+            c1: V3::gather(&m.map(|a| a.y_axis)),
+            c2: V3::gather(&m.map(|a| a.z_axis)),
+        }
+    }
+
+    /// Row `r` as a vector.
+    #[inline]
+    fn row(&self, r: usize) -> V3 {
+        let pick = |c: &V3| match r {
+            0 => c.x,
+            1 => c.y,
+            _ => c.z,
+        };
+        V3 {
+            x: pick(&self.c0),
+            y: pick(&self.c1),
+            z: pick(&self.c2),
+        }
+    }
+
+    /// Transpose per lane.
+    #[inline]
+    pub fn transpose(&self) -> M3 {
+        M3 {
+            c0: self.row(0),
+            c1: self.row(1),
+            c2: self.row(2),
+        }
+    }
+
+    /// Matrix × vector per lane.
+    #[inline]
+    pub fn mul_vec(&self, v: V3) -> V3 {
+        self.c0 * v.x + self.c1 * v.y + self.c2 * v.z
+    }
+
+    /// Matrix product per lane.
+    #[inline]
+    pub fn mul_mat(&self, o: &M3) -> M3 {
+        M3 {
+            c0: self.mul_vec(o.c0),
+            c1: self.mul_vec(o.c1),
+            c2: self.mul_vec(o.c2),
+        }
+    }
+
+    /// Determinant per lane (glam's order: `c2 · (c0 × c1)`).
+    #[inline]
+    pub fn determinant(&self) -> L {
+        self.c2.dot(self.c0.cross(self.c1))
+    }
+
+    /// Cofactor matrix `[c1×c2, c2×c0, c0×c1]` per lane.
+    #[inline]
+    pub fn cofactor(&self) -> M3 {
+        M3 {
+            c0: self.c1.cross(self.c2),
+            c1: self.c2.cross(self.c0),
+            c2: self.c0.cross(self.c1),
+        }
+    }
+
+    /// Trace per lane.
+    #[inline]
+    pub fn trace(&self) -> L {
+        self.c0.x + self.c1.y + self.c2.z
+    }
+
+    /// Squared Frobenius norm per lane.
+    #[inline]
+    pub fn norm2(&self) -> L {
+        self.c0.length_squared() + self.c1.length_squared() + self.c2.length_squared()
+    }
+}
+
+impl Add for M3 {
+    type Output = M3;
+    #[inline]
+    fn add(self, o: M3) -> M3 {
+        M3 {
+            c0: self.c0 + o.c0,
+            c1: self.c1 + o.c1,
+            c2: self.c2 + o.c2,
+        }
+    }
+}
+
+impl Sub for M3 {
+    type Output = M3;
+    #[inline]
+    fn sub(self, o: M3) -> M3 {
+        M3 {
+            c0: self.c0 - o.c0,
+            c1: self.c1 - o.c1,
+            c2: self.c2 - o.c2,
+        }
+    }
+}
+
+impl Mul<L> for M3 {
+    type Output = M3;
+    #[inline]
+    fn mul(self, s: L) -> M3 {
+        M3 {
+            c0: self.c0 * s,
+            c1: self.c1 * s,
+            c2: self.c2 * s,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat3, Vec3};
+
+    fn sample(k: usize) -> Mat3 {
+        let s = 1.0 + k as f32 * 0.1;
+        Mat3::from_cols_array(&[0.11, -0.05, 0.02, 0.07, -0.13, 0.04, -0.03, 0.09, 0.21]) * s
+            + Mat3::IDENTITY
+    }
+
+    #[test]
+    fn lanes_compute_what_glam_computes() {
+        let a: [Mat3; LANES] = std::array::from_fn(sample);
+        let b: [Mat3; LANES] = std::array::from_fn(|k| sample(k).transpose() * 0.5);
+        let (la, lb) = (M3::gather(&a), M3::gather(&b));
+        let prod = la.mul_mat(&lb);
+        let tr = la.transpose();
+        let cof = la.cofactor();
+        for k in 0..LANES {
+            let m = |x: &M3| Mat3::from_cols(x.c0.lane(k), x.c1.lane(k), x.c2.lane(k));
+            assert!(m(&prod).abs_diff_eq(a[k] * b[k], 1e-6));
+            assert_eq!(m(&tr), a[k].transpose());
+            let c = &a[k];
+            let glam_cof = Mat3::from_cols(
+                c.y_axis.cross(c.z_axis),
+                c.z_axis.cross(c.x_axis),
+                c.x_axis.cross(c.y_axis),
+            );
+            assert!(m(&cof).abs_diff_eq(glam_cof, 1e-6));
+            assert!((la.determinant().as_array()[k] - a[k].determinant()).abs() < 1e-6);
+            let v = Vec3::new(0.3, -0.2, 0.5 + k as f32);
+            let lv = V3::gather(&[v; LANES]);
+            assert!(la.mul_vec(lv).lane(k).abs_diff_eq(a[k] * v, 1e-6));
+        }
+    }
+}

@@ -1,0 +1,297 @@
+//! The rest-free pair's coupled projection for eight tets at once (one per SIMD lane):
+//! the same formulas, in the same order, as the scalar reference
+//! ([`super::rest_free`], [`super::strain`], [`super::neo_hookean::apply_pair`]), with each
+//! branch of the reference evaluated in every lane and chosen by a mask. Tets of one colour
+//! share no node, so eight of them are independent (PHYSICS.md §1.2, parallel form).
+
+use super::lanes::{L, M3, V3};
+use super::rest_free::{J_MIN, MIN_SHAPE};
+use super::strain::SERIES_LIMIT;
+
+/// Eight tets' inputs (padding lanes: zero displacement and weight, `Dm⁻¹ = I`, unit
+/// compliances, not live).
+#[derive(Debug, Clone, Copy)]
+pub struct TetLanes {
+    /// The four nodes' displacements from rest; projected in place.
+    pub u: [V3; 4],
+    /// The four nodes' inverse masses.
+    pub w: [L; 4],
+    /// Inverse rest shape matrices `Dm⁻¹`.
+    pub dm_inv: M3,
+    /// `α̃_H = 1/(λ V h²)` (infinite at λ = 0: no volume constraint).
+    pub alpha_h: L,
+    /// `α̃_D = 1/(μ V h²)`.
+    pub alpha_d: L,
+    /// All bits set in the lanes that hold a live tet.
+    pub live: L,
+}
+
+/// `x − ln(1 + x)`: the series below [`SERIES_LIMIT`], else direct (strain.rs
+/// `log1p_excess`).
+#[inline]
+fn log1p_excess(x: L) -> L {
+    let s = L::splat;
+    let x2 = x * x;
+    let tail = s(-1.0 / 7.0) + x * s(0.125);
+    let tail = s(-0.2) + x * (s(1.0 / 6.0) + x * tail);
+    let series = x2 * (s(0.5) + x * (s(-1.0 / 3.0) + x * (s(0.25) + x * tail)));
+    let direct = x - (L::ONE + x).ln();
+    x.abs().simd_lt(s(SERIES_LIMIT)).select(series, direct)
+}
+
+/// The invariants of `F = I + H` from `H` (strain.rs `Strain`).
+struct StrainLanes {
+    h: M3,
+    tr: L,
+    i2: L,
+    det_h: L,
+    j1: L,
+    cof_h: M3,
+}
+
+impl StrainLanes {
+    #[inline]
+    fn of(h: M3) -> Self {
+        let tr = h.trace();
+        let tr_h2 = h.mul_mat(&h).trace();
+        let i2 = L::splat(0.5) * (tr * tr - tr_h2);
+        let det_h = h.determinant();
+        StrainLanes {
+            h,
+            tr,
+            i2,
+            det_h,
+            j1: tr + i2 + det_h,
+            cof_h: h.cofactor(),
+        }
+    }
+
+    /// `cof F = (1 + tr H) I − Hᵀ + cof H`.
+    #[inline]
+    fn cof_f(&self) -> M3 {
+        M3::diagonal(L::ONE + self.tr) - self.h.transpose() + self.cof_h
+    }
+
+    /// `J F − cof F = (I₂ + det H) I + H + Hᵀ + (J − 1) H − cof H`.
+    #[inline]
+    fn j_f_minus_cof(&self) -> M3 {
+        M3::diagonal(self.i2 + self.det_h) + self.h + self.h.transpose() + self.h * self.j1
+            - self.cof_h
+    }
+}
+
+/// `L(J)`, `L'(J)` and whether `J > J_MIN` (rest_free.rs `log_volume`), given
+/// `excess = log1p_excess(J − 1)`.
+// docs/physics-notes.md, rest-free pair, C_H.
+#[inline]
+fn log_volume(s: &StrainLanes, excess: L) -> (L, L, L) {
+    let j = L::ONE + s.j1;
+    let above = j.simd_gt(L::splat(J_MIN));
+    let l = above.select(
+        s.j1 - excess,
+        L::splat(J_MIN.ln()) + (j - L::splat(J_MIN)) / L::splat(J_MIN),
+    );
+    let dl = above.select(L::ONE / j, L::splat(1.0 / J_MIN));
+    (l, dl, above)
+}
+
+/// `C_D = sqrt(ψ̂)`, `∂C_D/∂F`, and the lanes where `C_D` has a direction
+/// (rest_free.rs `shape_energy`, `shape_constraint`), given `log_volume` and the excess.
+// docs/physics-notes.md, rest-free pair, C_D.
+#[inline]
+fn shape_constraint(s: &StrainLanes, volume: (L, L, L), excess: L, cof_f: &M3) -> (L, M3, L) {
+    let (l, dl, above) = volume;
+    let two = L::splat(2.0);
+    let h_norm2 = s.h.norm2();
+    let j = L::ONE + s.j1;
+    let psi_above = h_norm2 - two * s.i2 - two * s.det_h + two * excess;
+    let psi_below = two * s.tr + h_norm2 - two * l;
+    let psi = above.select(psi_above, psi_below).max(L::ZERO);
+    let grad_above = s.j_f_minus_cof() * (L::ONE / j);
+    let grad_below = M3::diagonal(L::ONE) + s.h - *cof_f * dl;
+    let c = psi.sqrt();
+    let has = c.simd_ge(L::splat(MIN_SHAPE));
+    let half = select_m3(above, &grad_above, &grad_below);
+    (c, half * (L::ONE / c), has)
+}
+
+#[inline]
+fn select_v3(m: L, a: V3, b: V3) -> V3 {
+    V3 {
+        x: m.select(a.x, b.x),
+        y: m.select(a.y, b.y),
+        z: m.select(a.z, b.z),
+    }
+}
+
+#[inline]
+fn select_m3(m: L, a: &M3, b: &M3) -> M3 {
+    M3 {
+        c0: select_v3(m, a.c0, b.c0),
+        c1: select_v3(m, a.c1, b.c1),
+        c2: select_v3(m, a.c2, b.c2),
+    }
+}
+
+/// `G = (∂C/∂F) Dm⁻ᵀ`: `∇x1..3` = columns of G, `∇x0 = −(∇x1+∇x2+∇x3)`.
+// PHYSICS.md §1.2, vertex gradients.
+#[inline]
+fn vertex_gradients(dcdf: &M3, dm_inv_t: &M3) -> [V3; 4] {
+    let g = dcdf.mul_mat(dm_inv_t);
+    [-(g.c0 + g.c1 + g.c2), g.c0, g.c1, g.c2]
+}
+
+#[inline]
+fn weighted_dot(w: &[L; 4], a: &[V3; 4], b: &[V3; 4]) -> L {
+    w[0] * a[0].dot(b[0]) + w[1] * a[1].dot(b[1]) + w[2] * a[2].dot(b[2]) + w[3] * a[3].dot(b[3])
+}
+
+/// One row of the 2×2 system, or an empty row (zero gradient and value, unit compliance)
+/// where its constraint does not apply.
+#[inline]
+fn row(on: L, g: [V3; 4], c: L, alpha: L) -> ([V3; 4], L, L) {
+    (
+        g.map(|v| select_v3(on, v, V3::ZERO)),
+        on.select(c, L::ZERO),
+        on.select(alpha, L::ONE),
+    )
+}
+
+/// Project the eight tets' rest-free pair in place; returns each lane's volume multiplier
+/// of this substep (0 where there is no volume constraint or no live tet).
+// PHYSICS.md §1.2, XPBD update (block form, λ = 0 at the start of the substep);
+// docs/physics-notes.md, rest-free pair.
+#[inline]
+pub fn project_rest_free_lanes(t: &mut TetLanes) -> L {
+    let du = M3 {
+        c0: t.u[1] - t.u[0],
+        c1: t.u[2] - t.u[0],
+        c2: t.u[3] - t.u[0],
+    };
+    let s = StrainLanes::of(du.mul_mat(&t.dm_inv));
+    let dm_inv_t = t.dm_inv.transpose();
+    let excess = log1p_excess(s.j1);
+    let volume = log_volume(&s, excess);
+    let (c_h, dl, _) = volume;
+    let cof_f = s.cof_f();
+    let (c_d, dcd, has_shape) = shape_constraint(&s, volume, excess, &cof_f);
+    let with_volume = t.alpha_h.is_finite();
+    let (g_h, c_h, alpha_h) = row(
+        with_volume,
+        vertex_gradients(&(cof_f * dl), &dm_inv_t),
+        c_h,
+        t.alpha_h,
+    );
+    let (g_d, c_d, alpha_d) = row(has_shape, vertex_gradients(&dcd, &dm_inv_t), c_d, t.alpha_d);
+    // apply_pair: scale to O(1), solve, skip lanes with a singular (or NaN) system.
+    let a = weighted_dot(&t.w, &g_h, &g_h) + alpha_h;
+    let b = weighted_dot(&t.w, &g_h, &g_d);
+    let d = weighted_dot(&t.w, &g_d, &g_d) + alpha_d;
+    let sc = L::ONE / (a + d);
+    let (a, b, d) = (a * sc, b * sc, d * sc);
+    let det = a * d - b * b;
+    let ok = det.simd_gt(L::ZERO) & t.live;
+    let (r1, r2) = (-c_h * sc, -c_d * sc);
+    let dl_h = ok.select((r1 * d - b * r2) / det, L::ZERO);
+    let dl_d = ok.select((a * r2 - b * r1) / det, L::ZERO);
+    for i in 0..4 {
+        let dx = (g_h[i] * dl_h + g_d[i] * dl_d) * t.w[i];
+        t.u[i] = t.u[i] + select_v3(ok, dx, V3::ZERO);
+    }
+    dl_h
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Mat3, Vec3};
+
+    use super::*;
+    use crate::xpbd::lanes::LANES;
+    use crate::xpbd::neo_hookean::{TetProjection, TetTerms};
+    use crate::xpbd::rest_free::project_rest_free;
+
+    /// A tet's displacements: 0 at rest, growing with `k`, and a nearly flattened one
+    /// (J < J_MIN) and an inverted one.
+    fn displacements(k: usize) -> [Vec3; 4] {
+        let a = k as f32 * 0.07;
+        let base = [
+            Vec3::ZERO,
+            Vec3::new(0.3 * a, -0.1 * a, 0.05 * a),
+            Vec3::new(-0.02 * a, 0.2 * a, 0.1 * a),
+            Vec3::new(0.04 * a, -0.03 * a, -0.25 * a),
+        ];
+        match k {
+            6 => [
+                Vec3::ZERO,
+                Vec3::ZERO,
+                Vec3::ZERO,
+                Vec3::new(0.0, 0.0, -0.95),
+            ],
+            7 => [
+                Vec3::ZERO,
+                Vec3::ZERO,
+                Vec3::ZERO,
+                Vec3::new(0.1, 0.0, -1.4),
+            ],
+            _ => base,
+        }
+    }
+
+    fn terms(k: usize, alpha_h: f32) -> TetTerms {
+        TetTerms {
+            dm_inv: Mat3::from_diagonal(Vec3::new(1.0, 1.1, 0.9 + 0.01 * k as f32)),
+            alpha_h,
+            alpha_d: 0.3 + 0.05 * k as f32,
+            gamma: 1.0,
+        }
+    }
+
+    /// Lane k projects what the scalar reference projects for tet k, in every branch
+    /// (rest, small and large strain, J below J_MIN, inverted, no volume constraint),
+    /// and a lane that is not live stays put.
+    #[test]
+    fn lanes_match_the_scalar_reference() {
+        for alpha_h in [0.2f32, f32::INFINITY] {
+            let w = |k: usize| [1.0, 0.5 + 0.1 * k as f32, 2.0, 0.0];
+            let u: [[Vec3; 4]; LANES] = std::array::from_fn(displacements);
+            let dm: [Mat3; LANES] = std::array::from_fn(|k| terms(k, alpha_h).dm_inv);
+            let live: [f32; LANES] = std::array::from_fn(|k| {
+                if k == 5 {
+                    0.0
+                } else {
+                    f32::from_bits(u32::MAX)
+                }
+            });
+            let mut lanes = TetLanes {
+                u: std::array::from_fn(|j| V3::gather(&u.map(|t| t[j]))),
+                w: std::array::from_fn(|j| L::new(std::array::from_fn(|k| w(k)[j]))),
+                dm_inv: M3::gather(&dm),
+                alpha_h: L::splat(alpha_h),
+                alpha_d: L::new(std::array::from_fn(|k| terms(k, alpha_h).alpha_d)),
+                live: L::new(live),
+            };
+            let dl = project_rest_free_lanes(&mut lanes).to_array();
+            for k in 0..LANES {
+                let mut x = u[k];
+                let want = if k == 5 {
+                    0.0
+                } else {
+                    project_rest_free(&mut x, &w(k), &terms(k, alpha_h), TetProjection::Coupled)
+                };
+                let tol = 2e-6 * (1.0 + want.abs());
+                assert!(
+                    (dl[k] - want).abs() <= tol,
+                    "lane {k}: Δλ {} vs {want}",
+                    dl[k]
+                );
+                for (j, want) in x.iter().enumerate() {
+                    let got = lanes.u[j].lane(k);
+                    assert!(
+                        got.abs_diff_eq(*want, 2e-6),
+                        "lane {k} node {j} (α_H {alpha_h}): {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+}
