@@ -586,14 +586,19 @@ fn a_slow_solver_on_its_thread_costs_the_realtime_headset_no_frame() {
             SUMMARY_KEYS.map(|k| format!("{k} {}", r[k])).join(", ")
         );
     }
-    // 2.8 s at 72 Hz (less the last frame's length): every refresh is a display frame or
-    // a dropped one.
+    // 2.8 s at 72 Hz, less the last frames' length (up to 0.6 s when a frame waits for
+    // the solver): every refresh is a display frame or a dropped one.
     for r in [&base, &slow, &waits] {
         let shown = num(r, "frames") + num(r, "dropped_frames");
-        assert!((180.0..=204.0).contains(&shown), "{shown} refreshes: {r}");
+        assert!((150.0..=204.0).contains(&shown), "{shown} refreshes: {r}");
     }
-    // Other tests share the two cores: a few frames drop for them, not for the solver.
+    // Other tests share the two cores: a few frames drop for them, not for the solver
+    // (a display that waits for a 70 ms step drops about four refreshes in five).
     let (d_base, d_slow) = (num(&base, "dropped_frames"), num(&slow, "dropped_frames"));
+    assert!(
+        d_base < 50.0 && d_slow < 50.0,
+        "display frames dropped: {d_base} at full speed, {d_slow} slow"
+    );
     assert!(
         d_slow <= d_base + 3.0 + 0.05 * 202.0,
         "the slow solver dropped display frames: {d_slow} vs {d_base} at full speed\n{slow}\n{base}"

@@ -266,7 +266,7 @@ fn num(r: &Value, key: &str) -> f64 {
 /// a solver slowed by 250 ms a frame costs Monado's display no frame (the same dropped
 /// frames as at full speed, within noise) while the simulation's steps per second fall
 /// below 4. The same slowness stepped inside the frame loop (`--sim in-frame`) drops
-/// many: the measure sees a display that waits.
+/// many, or makes Monado stretch its period: the measure sees a display that waits.
 #[test]
 fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
     let Some(manifest) = monado::monado() else {
@@ -322,7 +322,13 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
         );
     }
     // Monado stretches the period it predicts for an app that is late; a display that
-    // never waits keeps the null compositor's rate.
+    // never waits keeps the null compositor's 20 Hz and drops few of its refreshes.
+    for r in [&base, &slow] {
+        assert!(
+            num(r, "display_hz") > 15.0 && num(r, "dropped_frames") < 12.0,
+            "the display waited: {r}"
+        );
+    }
     assert!(
         num(&slow, "display_hz") >= 0.9 * num(&base, "display_hz"),
         "the runtime slowed down for the slow solver\n{slow}\n{base}"
@@ -344,7 +350,7 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
     );
     assert!(
         num(&waits, "dropped_frames") > d_slow + 20.0
-            && num(&waits, "display_hz") < 0.5 * num(&slow, "display_hz"),
+            || num(&waits, "display_hz") < 0.5 * num(&slow, "display_hz"),
         "in-frame: {waits}"
     );
 }

@@ -23,10 +23,10 @@ use incise_xr::{RenderDevice, RenderSettings, Renderer};
 
 use super::exercise::XrExercise;
 use super::frame_log::{FrameLog, FrameRow};
-use super::in_frame::{Advanced, InFrameSim};
+use super::in_frame::InFrameSim;
 use super::sim_mode::SimMode;
 use super::sim_source::{RenderInput, Sim, ThreadSim};
-use super::sim_state::{SimState, ToolCommand};
+use super::sim_state::{Advanced, SimState, ToolCommand};
 use super::sim_step::{SimFaults, SimStepper};
 use super::sim_thread::{self, SimLink, ThreadConfig};
 use super::xr_body::XrBody;
@@ -189,6 +189,14 @@ pub fn run_loop(
     Ok(display.finish(ended, xr, exercise))
 }
 
+/// What a display frame showed: whether it rendered, the vibration amplitude sent, its
+/// tool-to-tissue latency (ms, rendered frames).
+struct Shown {
+    rendered: bool,
+    haptic: f32,
+    tool_latency_ms: Option<f64>,
+}
+
 /// The display side of a session.
 struct Display<'h, 'o> {
     headset: &'h mut dyn Headset,
@@ -314,20 +322,15 @@ impl<'o> Display<'_, 'o> {
         if !rendered {
             self.headset.end_frame(false)?;
         }
-        let latency = sim
-            .shown_command()
-            .filter(|_| rendered)
-            .map(|(_, t)| (frame.display_time - t) * 1e3);
-        self.log(
-            frame,
-            &adv,
-            &cmd,
-            sent,
-            latency,
-            started,
-            render_start,
+        let shown = Shown {
             rendered,
-        );
+            haptic: sent,
+            tool_latency_ms: sim
+                .shown_command()
+                .filter(|_| rendered)
+                .map(|(_, t)| (frame.display_time - t) * 1e3),
+        };
+        self.log(frame, &adv, &cmd, shown, [started, render_start]);
         self.maybe_exit(sim)
     }
 
@@ -454,32 +457,30 @@ impl<'o> Display<'_, 'o> {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// The frame's row; `clock`: when the frame and its rendering started.
     fn log(
         &mut self,
         frame: &HeadsetFrame,
         adv: &Advanced,
         cmd: &ToolCommand,
-        haptic: f32,
-        tool_latency_ms: Option<f64>,
-        started: Instant,
-        render_start: Instant,
-        rendered: bool,
+        shown: Shown,
+        clock: [Instant; 2],
     ) {
+        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
         self.out.log.rows.push(FrameRow {
             frame: self.out.frames,
             display_time: frame.display_time,
             sim_frames: adv.sim_frames,
             substeps: adv.substeps,
             sim_ms: adv.sim_ms,
-            render_ms: render_start.elapsed().as_secs_f64() * 1e3,
-            frame_ms: started.elapsed().as_secs_f64() * 1e3,
-            rendered,
+            render_ms: ms(clock[1]),
+            frame_ms: ms(clock[0]),
+            rendered: shown.rendered,
             engaged: cmd.engaged,
             tool_force: adv.tool_force,
-            haptic,
+            haptic: shown.haptic,
             display_period: frame.display_period,
-            tool_latency_ms,
+            tool_latency_ms: shown.tool_latency_ms,
         });
         self.out.frames += 1;
     }

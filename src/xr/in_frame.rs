@@ -11,7 +11,7 @@ use incise_xr::openxr::HeadsetFrame;
 use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
 
 use super::exercise::XrExercise;
-use super::sim_state::ToolCommand;
+use super::sim_state::{Advanced, ToolCommand};
 use super::sim_step::{SimStepper, Stepped};
 use super::xr_body::XrBody;
 
@@ -19,19 +19,6 @@ use super::xr_body::XrBody;
 pub const SIM_BUDGET: f64 = 0.5;
 /// Most simulation frames stepped in one display frame.
 pub const MAX_SIM_FRAMES: u32 = 3;
-
-/// What one display frame's simulation did.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Advanced {
-    /// Simulation frames completed since the previous display frame.
-    pub sim_frames: u32,
-    /// Substeps per simulation frame.
-    pub substeps: u32,
-    /// Wall time of the simulation, ms (the thread: of its latest frame).
-    pub sim_ms: f64,
-    /// Contact force to vibrate with, N.
-    pub tool_force: f32,
-}
 
 /// The in-frame simulation.
 pub struct InFrameSim<'s, 'x> {

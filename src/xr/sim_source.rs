@@ -11,8 +11,8 @@ use incise_xr::openxr::HeadsetFrame;
 use incise_xr::{BodyState, RenderDevice};
 
 use super::exercise::XrExercise;
-use super::in_frame::{Advanced, InFrameSim};
-use super::sim_state::{CommandStamp, SimState, ToolCommand};
+use super::in_frame::InFrameSim;
+use super::sim_state::{Advanced, CommandStamp, SimState, ToolCommand};
 use super::sim_thread::SimLink;
 use super::xr_body::XrBody;
 use crate::screenshots::stress_scale;

@@ -30,6 +30,19 @@ pub struct ToolCommand {
     pub resets: u64,
 }
 
+/// What one display frame's simulation did.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Advanced {
+    /// Simulation frames completed since the previous display frame.
+    pub sim_frames: u32,
+    /// Substeps per simulation frame.
+    pub substeps: u32,
+    /// Wall time of the simulation, ms (the thread: of its latest frame).
+    pub sim_ms: f64,
+    /// Contact force to vibrate with, N.
+    pub tool_force: f32,
+}
+
 /// The newest command a simulation frame was stepped with: its display frame and
 /// predicted display time, s.
 pub type CommandStamp = (u64, f64);
