@@ -166,9 +166,10 @@ pub fn run(opts: &XrOptions) -> Result<XrReport> {
             })?;
             eprintln!("xr: backdrop {:?}", session.backdrop());
             let dev = session.device().clone();
-            let (mut xr, skin) = XrBody::load(&scene, opts.device, &dev)?;
-            let tray = tray_for(&xr);
             let mode = sim_mode::resolve(opts.sim, exercise.is_some(), false)?;
+            let solver_dev = solver_device(opts.device, mode.0, &dev)?;
+            let (mut xr, skin) = XrBody::load(&scene, opts.device, &solver_dev)?;
+            let tray = tray_for(&xr);
             run_session(
                 &mut session,
                 &mut xr,
@@ -178,6 +179,18 @@ pub fn run(opts: &XrOptions) -> Result<XrReport> {
                 exercise.as_mut(),
             )
         }
+    }
+}
+
+/// The device a GPU solver runs on: on the simulation thread its own (a second logical
+/// device with its own queue, on the best adapter: [`RenderDevice::separate`]), so its
+/// submissions and waits never hold up the renderer's on the headset's device (measured
+/// on lavapipe, sharing it made the display wait: 66 of 120 refreshes dropped on
+/// Monado); in the frame, or for a CPU solver, the renderer's.
+fn solver_device(choice: DeviceChoice, mode: SimMode, dev: &RenderDevice) -> Result<RenderDevice> {
+    match (choice, mode) {
+        (DeviceChoice::Cpu, _) | (_, SimMode::InFrame) => Ok(dev.clone()),
+        _ => RenderDevice::separate().context("opening the simulation thread's GPU device"),
     }
 }
 
@@ -198,7 +211,8 @@ fn run_simulated(
         DeviceChoice::Auto => DeviceChoice::Cpu,
         d => d,
     };
-    let (mut xr, skin) = XrBody::load(scene, device, &dev)?;
+    let mode = sim_mode::resolve(opts.sim, exercise.is_some(), !script.realtime)?;
+    let (mut xr, skin) = XrBody::load(scene, device, &solver_device(device, mode.0, &dev)?)?;
     let tray = tray_for(&xr);
     let stroke = match &script.right {
         Some(RightTrack::Tool { stroke, .. }) => Some(match stroke {
@@ -213,7 +227,6 @@ fn run_simulated(
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("creating {}", opts.out.display()))?;
     let nominal = script.pacing == Pacing::Nominal;
-    let mode = sim_mode::resolve(opts.sim, exercise.is_some(), !script.realtime)?;
     let mut headset =
         SimulatedHeadset::new(script, stroke, tray, BladeOffset::default(), dev, &opts.out)?;
     run_session(
