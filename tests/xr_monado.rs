@@ -257,6 +257,23 @@ fn a_stroke_played_through_monado_cuts_along_it_and_replays_to_the_same_cut() {
     assert_validation_clean(&session, &dir, layers);
 }
 
+/// Display refreshes missed after the first five frames (the start-up: the renderer's
+/// first pipeline compiles beside the solver's first steps, up to 0.6 s under the
+/// validation layers), counted from `out`/frames.csv at the report's display rate.
+fn steady_dropped(out: &std::path::Path, r: &Value) -> f64 {
+    let period = 1.0 / num(r, "display_hz");
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let times: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    times[5..]
+        .windows(2)
+        .map(|w| (((w[1] - w[0]) / period).round() - 1.0).max(0.0))
+        .sum()
+}
+
 /// A field of the report as f64.
 fn num(r: &Value, key: &str) -> f64 {
     r[key].as_f64().unwrap_or_else(|| panic!("no {key} in {r}"))
@@ -294,6 +311,8 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
         let r = monado::report(&out, &o);
         assert_eq!(r["exit"], "Exited", "{name}: {r}");
         assert_eq!(r["frames"].as_u64(), Some(40), "{name}: {r}");
+        let mut r = r;
+        r["steady_dropped"] = steady_dropped(&out, &r).into();
         r
     };
     let base = run("base", &[]);
@@ -310,6 +329,7 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
             "frames",
             "rendered",
             "dropped_frames",
+            "steady_dropped",
             "display_hz",
             "sim_frames",
             "sim_steps_per_s",
@@ -322,10 +342,11 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
         );
     }
     // Monado stretches the period it predicts for an app that is late; a display that
-    // never waits keeps the null compositor's 20 Hz and drops few of its refreshes.
+    // never waits keeps the null compositor's 20 Hz and, once started, drops few of its
+    // refreshes.
     for r in [&base, &slow] {
         assert!(
-            num(r, "display_hz") > 15.0 && num(r, "dropped_frames") < 12.0,
+            num(r, "display_hz") > 15.0 && num(r, "steady_dropped") < 8.0,
             "the display waited: {r}"
         );
     }
@@ -333,7 +354,7 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
         num(&slow, "display_hz") >= 0.9 * num(&base, "display_hz"),
         "the runtime slowed down for the slow solver\n{slow}\n{base}"
     );
-    let (d_base, d_slow) = (num(&base, "dropped_frames"), num(&slow, "dropped_frames"));
+    let (d_base, d_slow) = (num(&base, "steady_dropped"), num(&slow, "steady_dropped"));
     assert!(
         d_slow <= d_base + 3.0,
         "the slow solver dropped display frames: {d_slow} vs {d_base} at full speed\n{slow}\n{base}"
@@ -393,7 +414,7 @@ fn the_gpu_solver_on_its_thread_costs_monado_no_display_frame() {
     );
     assert!(num(&r, "sim_frames") > 0.0, "{r}");
     assert!(
-        num(&r, "display_hz") > 15.0 && num(&r, "dropped_frames") < 12.0,
+        num(&r, "display_hz") > 15.0 && steady_dropped(&out, &r) < 8.0,
         "the display waited for the GPU solver: {r}"
     );
 }

@@ -194,7 +194,7 @@ impl SimLoop<'_, '_> {
                 continue;
             }
             let started = Instant::now();
-            self.step_frames(plan.sim_frames, plan.substeps)?;
+            self.step_frames(plan.sim_frames, plan.substeps, rebuilt)?;
             self.pacer.record(plan, started.elapsed().as_secs_f64());
             self.min_substeps = self.min_substeps.min(plan.substeps);
         }
@@ -219,9 +219,9 @@ impl SimLoop<'_, '_> {
         Ok(true)
     }
 
-    /// `frames` frames at `substeps`, each with the newest command, each published.
-    fn step_frames(&mut self, frames: u32, substeps: u32) -> Result<()> {
-        let mut rebuilt = false;
+    /// `frames` frames at `substeps`, each with the newest command, each published
+    /// (`rebuilt`: the scene was rebuilt since the last one published).
+    fn step_frames(&mut self, frames: u32, substeps: u32, mut rebuilt: bool) -> Result<()> {
         if substeps != self.xr.solver().params().substeps {
             self.xr.set_substeps(substeps)?;
             rebuilt = true;
