@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 use crate::body::DeviceChoice;
 use crate::screenshots::{ImageSize, OverlayArg};
+use crate::xr::sim_mode::SimChoice;
 
 /// incise: mixed-reality surgical cutting trainer (headless runner, mesh tools, benchmarks).
 #[derive(Debug, Parser)]
@@ -129,6 +130,18 @@ pub enum Command {
         /// ends when the stroke has been played (for demos and tests).
         #[arg(long, value_name = "FILE")]
         stroke: Option<PathBuf>,
+        /// Where the solver is stepped: on its own thread paced to real time, each display
+        /// frame showing its latest completed state (the display never waits for it), or
+        /// inside each display frame (lockstep, deterministic). auto: the thread, except
+        /// in exercise sessions and on a simulated headset's virtual clock.
+        #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
+        sim: SimChoice,
+        /// Testing aid: sleep N ms in every simulation frame (an artificially slow solver).
+        #[arg(long, value_name = "N", default_value_t = 0, hide = true)]
+        slow_sim_ms: u64,
+        /// Testing aid: panic in the simulation just before simulation frame N.
+        #[arg(long, value_name = "N", hide = true)]
+        inject_sim_panic_at: Option<u64>,
     },
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {

@@ -127,6 +127,9 @@ fn main() -> ExitCode {
             history,
             inject_nan_at,
             stroke,
+            sim,
+            slow_sim_ms,
+            inject_sim_panic_at,
         } => incise::xr::run(&incise::xr::XrOptions {
             scene: scene.unwrap_or_else(|| XR_SCENE.into()),
             simulated: simulated_headset,
@@ -138,6 +141,9 @@ fn main() -> ExitCode {
             history,
             inject_nan_at,
             stroke,
+            sim,
+            slow_sim_ms,
+            inject_sim_panic_at,
         })
         .map(|r| println!("{}", r.summary())),
         Command::Render {

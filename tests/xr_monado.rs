@@ -89,18 +89,24 @@ fn a_session_on_monado_runs_from_idle_to_exiting_and_renders_every_frame_it_may(
     let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
     assert_eq!(csv.lines().count(), 31);
     // Display frames the runtime skipped while incise was late, counted from the
-    // predicted display times at its nominal period (Monado's pacing also stretches the
-    // period of a slow app; with the solver inside the frame loop most frames are late).
+    // predicted display times at its nominal period: the shortest it predicted after the
+    // first rendered frame (before it, Monado guesses 16 ms; then its null compositor's
+    // 50 ms, stretched for a slow app).
+    assert_eq!(r["sim_mode"], "thread", "the default: {r}");
     assert!(r["display_hz"].as_f64().unwrap() > 1.0, "{r}");
-    let rows: Vec<(f64, f64)> = csv
+    let rows: Vec<(f64, f64, bool)> = csv
         .lines()
         .skip(1)
         .map(|l| {
             let c: Vec<&str> = l.split(',').collect();
-            (c[1].parse().unwrap(), c[11].parse().unwrap())
+            (c[1].parse().unwrap(), c[11].parse().unwrap(), c[7] == "1")
         })
         .collect();
-    let nominal = rows.iter().map(|r| r.1).fold(f64::INFINITY, f64::min);
+    let first = rows.iter().position(|r| r.2).unwrap();
+    let nominal = rows[first + 1..]
+        .iter()
+        .map(|r| r.1)
+        .fold(f64::INFINITY, f64::min);
     assert!(
         (r["display_hz"].as_f64().unwrap() - 1.0 / nominal).abs() < 1e-3,
         "{r}"
@@ -114,10 +120,6 @@ fn a_session_on_monado_runs_from_idle_to_exiting_and_renders_every_frame_it_may(
     assert!(
         dropped.abs_diff(skipped) <= 1 + skipped / 50,
         "{dropped} dropped, {skipped} from frames.csv: {r}"
-    );
-    assert!(
-        dropped > 0,
-        "the solver inside the frame loop is late on lavapipe: {r}"
     );
     assert!(r["sim_steps_per_s"].as_f64().unwrap() > 0.0, "{r}");
     // The fixed grip pose was recorded, and loads as a stroke.
@@ -253,4 +255,166 @@ fn a_stroke_played_through_monado_cuts_along_it_and_replays_to_the_same_cut() {
         "replay {replayed} vs session {live} tets"
     );
     assert_validation_clean(&session, &dir, layers);
+}
+
+/// Display refreshes missed after the first five frames (the start-up: the renderer's
+/// first pipeline compiles beside the solver's first steps, up to 0.6 s under the
+/// validation layers), counted from `out`/frames.csv at the report's display rate.
+fn steady_dropped(out: &std::path::Path, r: &Value) -> f64 {
+    let period = 1.0 / num(r, "display_hz");
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let times: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    times[5..]
+        .windows(2)
+        .map(|w| (((w[1] - w[0]) / period).round() - 1.0).max(0.0))
+        .sum()
+}
+
+/// A field of the report as f64.
+fn num(r: &Value, key: &str) -> f64 {
+    r[key].as_f64().unwrap_or_else(|| panic!("no {key} in {r}"))
+}
+
+/// Issue 19 item 3 on a real runtime: with the solver on its own thread (the default),
+/// a solver slowed by 250 ms a frame costs Monado's display no frame (the same dropped
+/// frames as at full speed, within noise) while the simulation's steps per second fall
+/// below 4. The same slowness stepped inside the frame loop (`--sim in-frame`) drops
+/// many, or makes Monado stretch its period: the measure sees a display that waits.
+#[test]
+fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
+    let Some(manifest) = monado::monado() else {
+        return;
+    };
+    let layers = monado::validation();
+    let dir = temp_dir("xr-monado-slow");
+    let run = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec![
+            "xr",
+            SCENE,
+            "--frames",
+            "40",
+            "--device",
+            "cpu",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let scratch = dir.join(format!("{name}-scratch"));
+        let o = monado::run(manifest, &scratch, &args, layers);
+        assert_eq!(o.status.code(), Some(0), "{name}: {}", text(&o.stderr));
+        assert_validation_clean(&o, &scratch, layers);
+        let r = monado::report(&out, &o);
+        assert_eq!(r["exit"], "Exited", "{name}: {r}");
+        assert_eq!(r["frames"].as_u64(), Some(40), "{name}: {r}");
+        let mut r = r;
+        r["steady_dropped"] = steady_dropped(&out, &r).into();
+        r
+    };
+    let base = run("base", &[]);
+    let slow = run("slow", &["--slow-sim-ms", "250"]);
+    let waits = run("in-frame", &["--sim", "in-frame", "--slow-sim-ms", "250"]);
+    assert_eq!(base["sim_mode"], "thread", "the default: {base}");
+    assert_eq!(waits["sim_mode"], "in-frame", "{waits}");
+    for (name, r) in [
+        ("full speed", &base),
+        ("slow", &slow),
+        ("slow in-frame", &waits),
+    ] {
+        let keys = [
+            "frames",
+            "rendered",
+            "dropped_frames",
+            "steady_dropped",
+            "display_hz",
+            "sim_frames",
+            "sim_steps_per_s",
+            "tool_latency_ms_p50_p95",
+            "frame_ms_p50_p95",
+        ];
+        eprintln!(
+            "{name}: {}",
+            keys.map(|k| format!("{k} {}", r[k])).join(", ")
+        );
+    }
+    // Monado stretches the period it predicts for an app that is late; a display that
+    // never waits keeps the null compositor's 20 Hz and, once started, drops few of its
+    // refreshes.
+    for r in [&base, &slow] {
+        assert!(
+            num(r, "display_hz") > 15.0 && num(r, "steady_dropped") < 8.0,
+            "the display waited: {r}"
+        );
+    }
+    assert!(
+        num(&slow, "display_hz") >= 0.9 * num(&base, "display_hz"),
+        "the runtime slowed down for the slow solver\n{slow}\n{base}"
+    );
+    let (d_base, d_slow) = (num(&base, "steady_dropped"), num(&slow, "steady_dropped"));
+    assert!(
+        d_slow <= d_base + 3.0,
+        "the slow solver dropped display frames: {d_slow} vs {d_base} at full speed\n{slow}\n{base}"
+    );
+    let (s_base, s_slow) = (num(&base, "sim_steps_per_s"), num(&slow, "sim_steps_per_s"));
+    assert!(
+        s_slow < 4.0 && s_slow < 0.7 * s_base,
+        "{s_slow} vs {s_base} steps/s"
+    );
+    let lag = |r: &Value| r["tool_latency_ms_p50_p95"][0].as_f64().unwrap();
+    assert!(
+        lag(&slow) >= 250.0 && lag(&slow) > lag(&base),
+        "{slow}\n{base}"
+    );
+    assert!(
+        num(&waits, "dropped_frames") > d_slow + 20.0
+            || num(&waits, "display_hz") < 0.5 * num(&slow, "display_hz"),
+        "in-frame: {waits}"
+    );
+}
+
+/// The GPU solver on the simulation thread gets its own device and queue: its compute
+/// and waits do not hold up the renderer's submissions to the runtime's device (sharing
+/// it, lavapipe made the display wait: 66 of 120 refreshes dropped).
+#[test]
+fn the_gpu_solver_on_its_thread_costs_monado_no_display_frame() {
+    let Some(manifest) = monado::monado() else {
+        return;
+    };
+    // Without the Vulkan validation layer: on lavapipe it serialises the two devices'
+    // pipeline compiles (a substep change rebuilds the GPU solver: about a second of
+    // JIT), stalling the renderer for reasons of the emulated GPU, not of the thread.
+    let layers = monado::Validation {
+        vulkan: false,
+        ..monado::validation()
+    };
+    let dir = temp_dir("xr-monado-gpu");
+    let out = dir.join("out");
+    let args = [
+        "xr",
+        SCENE,
+        "--frames",
+        "40",
+        "--device",
+        "gpu",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let o = monado::run(manifest, &dir, &args, layers);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    assert_validation_clean(&o, &dir, layers);
+    let r = monado::report(&out, &o);
+    assert_eq!(r["sim_mode"], "thread", "{r}");
+    assert!(
+        r["solver_device"].as_str().unwrap().starts_with("gpu"),
+        "{r}"
+    );
+    assert!(num(&r, "sim_frames") > 0.0, "{r}");
+    assert!(
+        num(&r, "display_hz") > 15.0 && steady_dropped(&out, &r) < 8.0,
+        "the display waited for the GPU solver: {r}"
+    );
 }

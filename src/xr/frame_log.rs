@@ -33,6 +33,10 @@ pub struct FrameRow {
     pub haptic: f32,
     /// The runtime's predicted display period for this frame, s.
     pub display_period: f64,
+    /// Tool-to-tissue latency of a rendered frame, ms: its predicted display time minus
+    /// that of the display frame whose tool pose was the newest the shown tissue state
+    /// was stepped with (see [`FrameLog::latency_ms_quantile`]); empty when not rendered.
+    pub tool_latency_ms: Option<f64>,
 }
 
 /// The rows of a session.
@@ -46,12 +50,12 @@ impl FrameLog {
     /// The log as CSV with a header line.
     pub fn to_csv(&self) -> String {
         let mut s = String::from(
-            "frame,display_time_s,sim_frames,substeps,sim_ms,render_ms,frame_ms,rendered,engaged,tool_force_n,haptic,display_period_s\n",
+            "frame,display_time_s,sim_frames,substeps,sim_ms,render_ms,frame_ms,rendered,engaged,tool_force_n,haptic,display_period_s,tool_latency_ms\n",
         );
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{},{:.6},{},{},{:.3},{:.3},{:.3},{},{},{:.4},{:.3},{:.6}",
+                "{},{:.6},{},{},{:.3},{:.3},{:.3},{},{},{:.4},{:.3},{:.6},{}",
                 r.frame,
                 r.display_time,
                 r.sim_frames,
@@ -63,7 +67,9 @@ impl FrameLog {
                 u8::from(r.engaged),
                 r.tool_force,
                 r.haptic,
-                r.display_period
+                r.display_period,
+                r.tool_latency_ms
+                    .map_or(String::new(), |l| format!("{l:.3}"))
             );
         }
         s
@@ -77,14 +83,26 @@ impl FrameLog {
 
     /// The nominal display rate (Hz, from the shortest predicted period) and the display
     /// refreshes missed between the logged frames at that rate (a frame that came late
-    /// is shown one or more refreshes after the one before it plus one).
+    /// is shown one or more refreshes after the one before it plus one). The periods
+    /// predicted up to the first rendered frame are left out of the nominal one: the
+    /// runtime has not timed a frame of the app yet (Monado's null compositor predicts
+    /// 16 ms there, then its 50 ms).
     pub fn missed_refreshes(&self) -> (f64, u64) {
-        let nominal = self
+        let settled = self
             .rows
             .iter()
-            .map(|r| r.display_period)
-            .filter(|p| *p > 0.0)
-            .fold(f64::INFINITY, f64::min);
+            .position(|r| r.rendered)
+            .map_or(0, |i| i + 1);
+        let shortest = |rows: &[FrameRow]| {
+            rows.iter()
+                .map(|r| r.display_period)
+                .filter(|p| *p > 0.0)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut nominal = shortest(&self.rows[settled.min(self.rows.len())..]);
+        if !nominal.is_finite() {
+            nominal = shortest(&self.rows);
+        }
         if !nominal.is_finite() {
             return (0.0, 0);
         }
@@ -101,19 +119,34 @@ impl FrameLog {
 
     /// The `q`-quantile (0..1) of frame wall times, ms, over rendered frames.
     pub fn frame_ms_quantile(&self, q: f64) -> Option<f64> {
-        let mut v: Vec<f64> = self
-            .rows
-            .iter()
-            .filter(|r| r.rendered)
-            .map(|r| r.frame_ms)
-            .collect();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let i = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
-        Some(v[i])
+        let rendered = self.rows.iter().filter(|r| r.rendered);
+        quantile(rendered.map(|r| r.frame_ms).collect(), q)
     }
+
+    /// The `q`-quantile (0..1) of the tool-to-tissue latency, ms, over rendered frames.
+    /// A rendered frame's latency is its predicted display time minus the predicted
+    /// display time of the frame whose tool command (the scalpel pose sampled for that
+    /// display time, and the trigger) was the newest one the simulation state it shows
+    /// had been stepped with: how long after the pose was meant to be seen the tissue
+    /// shows its effect. Stepping in the frame gives 0 when the frame stepped; the
+    /// thread gives at least the display period (the command reaches the thread as the
+    /// frame is rendered) plus the step's time.
+    pub fn latency_ms_quantile(&self, q: f64) -> Option<f64> {
+        quantile(
+            self.rows.iter().filter_map(|r| r.tool_latency_ms).collect(),
+            q,
+        )
+    }
+}
+
+/// The nearest-rank `q`-quantile of `v`.
+fn quantile(mut v: Vec<f64>, q: f64) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let i = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+    Some(v[i])
 }
 
 #[cfg(test)]
@@ -136,6 +169,11 @@ mod tests {
         assert!(csv.starts_with("frame,display_time_s"));
         assert_eq!(log.frame_ms_quantile(0.5), Some(20.0));
         assert_eq!(log.frame_ms_quantile(1.0), Some(30.0));
+        assert_eq!(log.latency_ms_quantile(0.5), None);
+        log.rows[1].tool_latency_ms = Some(13.9);
+        assert_eq!(log.latency_ms_quantile(0.95), Some(13.9));
+        assert!(log.to_csv().lines().nth(2).unwrap().ends_with(",13.900"));
+        assert!(log.to_csv().lines().nth(1).unwrap().ends_with(','));
     }
 
     #[test]
@@ -158,5 +196,13 @@ mod tests {
         assert!((hz - 20.0).abs() < 1e-9);
         assert_eq!(missed, 4);
         assert_eq!(FrameLog::default().missed_refreshes(), (0.0, 0));
+        // A runtime's guess before the app's first rendered frame does not set the rate:
+        // 16 ms predicted at first, then 50 ms frames on time.
+        let mut start = vec![row(0.0, 0.016), row(0.016, 0.016)];
+        start[1].rendered = true;
+        start.extend((1..5).map(|i| row(0.016 + 0.05 * i as f64, 0.05)));
+        let (hz, missed) = FrameLog { rows: start }.missed_refreshes();
+        assert!((hz - 20.0).abs() < 1e-9, "{hz}");
+        assert_eq!(missed, 0);
     }
 }

@@ -5,12 +5,20 @@
 pub mod exercise;
 pub mod frame_log;
 pub mod frame_loop;
+pub mod in_frame;
+pub mod latest;
 pub mod script;
+pub mod sim_mode;
+pub mod sim_source;
+pub mod sim_state;
+pub mod sim_step;
+pub mod sim_thread;
 pub mod simulated;
 pub mod unavailable;
 pub mod xr_body;
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use incise_scalpel::HapticCurve;
@@ -24,6 +32,8 @@ use crate::body::DeviceChoice;
 use exercise::{AttemptSummary, XrExercise};
 use frame_loop::{LoopOptions, LoopOutcome, run_loop};
 use script::{HeadsetScript, Pacing, RightTrack};
+use sim_mode::{SimChoice, SimMode};
+use sim_step::SimFaults;
 use simulated::SimulatedHeadset;
 pub use unavailable::XrUnavailable;
 use xr_body::XrBody;
@@ -54,6 +64,13 @@ pub struct XrOptions {
     /// Drive the scalpel along this recorded stroke (simulation time) instead of the
     /// right controller; the session ends when it has been played.
     pub stroke: Option<PathBuf>,
+    /// Where the solver is stepped (its own thread by default).
+    pub sim: SimChoice,
+    /// Testing aid: sleep this long in every simulation frame (an artificially slow
+    /// solver).
+    pub slow_sim_ms: u64,
+    /// Testing aid: a panic in the simulation just before this simulation frame.
+    pub inject_sim_panic_at: Option<u64>,
 }
 
 /// The session summary written as `xr_report.json`.
@@ -65,11 +82,17 @@ pub struct XrReport {
     pub headset: String,
     /// Solver device.
     pub solver_device: String,
-    /// Display frames.
+    /// Where the solver was stepped: "thread" (its own thread, paced to real time; each
+    /// display frame renders its latest completed state) or "in-frame" (inside each
+    /// display frame, which waits for it).
+    pub sim_mode: String,
+    /// Why that mode.
+    pub sim_mode_why: String,
+    /// Display frames (begun by the runtime's frame loop).
     pub frames: u64,
-    /// Frames rendered.
+    /// Display frames rendered (ended with a projection layer).
     pub rendered: u64,
-    /// Simulation frames.
+    /// Simulation frames stepped.
     pub sim_frames: u64,
     /// The session states the runtime reported, in order (IDLE first).
     pub session_states: Vec<String>,
@@ -92,8 +115,16 @@ pub struct XrReport {
     pub display_hz: f64,
     /// Display frames the runtime skipped because a frame came late.
     pub dropped_frames: u64,
-    /// Simulation frames stepped per second of wall time.
+    /// Simulation frames stepped per second of wall time (over the simulation's wall
+    /// time: the thread's, from its first command; in the frame, the session's).
     pub sim_steps_per_s: f64,
+    /// Tool-to-tissue latency, median and 95th percentile over rendered frames, ms: a
+    /// frame's predicted display time minus that of the frame whose tool pose (sampled
+    /// for its predicted display time) was the newest the tissue it shows was stepped
+    /// with (`frames.csv`: tool_latency_ms).
+    pub tool_latency_ms_p50_p95: Option<(f64, f64)>,
+    /// The testing aid's sleep per simulation frame, ms (0: none).
+    pub slow_sim_ms: u64,
     /// Scene substeps and the fewest used.
     pub substeps: (u32, u32),
     /// Median and 95th-percentile wall time of rendered frames, ms.
@@ -135,18 +166,31 @@ pub fn run(opts: &XrOptions) -> Result<XrReport> {
             })?;
             eprintln!("xr: backdrop {:?}", session.backdrop());
             let dev = session.device().clone();
-            let (mut xr, skin) = XrBody::load(&scene, opts.device, &dev)?;
+            let mode = sim_mode::resolve(opts.sim, exercise.is_some(), false)?;
+            let solver_dev = solver_device(opts.device, mode.0, &dev)?;
+            let (mut xr, skin) = XrBody::load(&scene, opts.device, &solver_dev)?;
             let tray = tray_for(&xr);
             run_session(
                 &mut session,
                 &mut xr,
                 &skin,
                 opts,
-                tray,
-                false,
+                (tray, false, mode),
                 exercise.as_mut(),
             )
         }
+    }
+}
+
+/// The device a GPU solver runs on: on the simulation thread its own (a second logical
+/// device with its own queue, on the best adapter: [`RenderDevice::separate`]), so its
+/// submissions and waits never hold up the renderer's on the headset's device (measured
+/// on lavapipe, sharing it made the display wait: 66 of 120 refreshes dropped on
+/// Monado); in the frame, or for a CPU solver, the renderer's.
+fn solver_device(choice: DeviceChoice, mode: SimMode, dev: &RenderDevice) -> Result<RenderDevice> {
+    match (choice, mode) {
+        (DeviceChoice::Cpu, _) | (_, SimMode::InFrame) => Ok(dev.clone()),
+        _ => RenderDevice::separate().context("opening the simulation thread's GPU device"),
     }
 }
 
@@ -167,7 +211,8 @@ fn run_simulated(
         DeviceChoice::Auto => DeviceChoice::Cpu,
         d => d,
     };
-    let (mut xr, skin) = XrBody::load(scene, device, &dev)?;
+    let mode = sim_mode::resolve(opts.sim, exercise.is_some(), !script.realtime)?;
+    let (mut xr, skin) = XrBody::load(scene, device, &solver_device(device, mode.0, &dev)?)?;
     let tray = tray_for(&xr);
     let stroke = match &script.right {
         Some(RightTrack::Tool { stroke, .. }) => Some(match stroke {
@@ -184,16 +229,26 @@ fn run_simulated(
     let nominal = script.pacing == Pacing::Nominal;
     let mut headset =
         SimulatedHeadset::new(script, stroke, tray, BladeOffset::default(), dev, &opts.out)?;
-    run_session(&mut headset, &mut xr, &skin, opts, tray, nominal, exercise)
+    run_session(
+        &mut headset,
+        &mut xr,
+        &skin,
+        opts,
+        (tray, nominal, mode),
+        exercise,
+    )
 }
+
+/// The tray at the start, whether the headset asks for the scene's substeps always, and
+/// the simulation mode with why.
+type SessionSetup = (Tray, bool, (SimMode, String));
 
 fn run_session(
     headset: &mut dyn Headset,
     xr: &mut XrBody,
     skin: &incise_sim::skin::Skin,
     opts: &XrOptions,
-    tray: Tray,
-    nominal_pacing: bool,
+    (tray, nominal_pacing, (sim_mode, sim_mode_why)): SessionSetup,
     mut exercise: Option<&mut XrExercise>,
 ) -> Result<XrReport> {
     std::fs::create_dir_all(&opts.out)
@@ -209,6 +264,7 @@ fn run_session(
         .transpose()?;
     let describe = headset.describe();
     eprintln!("xr: {describe}");
+    eprintln!("xr: simulation {} ({sim_mode_why})", sim_mode.name());
     let mut outcome: LoopOutcome = run_loop(
         headset,
         xr,
@@ -222,8 +278,13 @@ fn run_session(
             nominal_pacing: nominal_pacing || played.is_some(),
             record: true,
             tray,
-            inject_nan_at: opts.inject_nan_at,
             stroke: played.as_ref(),
+            sim_mode,
+            faults: SimFaults {
+                nan_at: opts.inject_nan_at,
+                panic_at: opts.inject_sim_panic_at,
+                slow: Duration::from_millis(opts.slow_sim_ms),
+            },
         },
         exercise.as_deref_mut(),
     )?;
@@ -238,10 +299,13 @@ fn run_session(
         stroke_path = Some(p.display().to_string());
     }
     let quant = |q| outcome.log.frame_ms_quantile(q);
+    let latency = |q| outcome.log.latency_ms_quantile(q);
     let report = XrReport {
         scene: xr.scene_path().display().to_string(),
         headset: describe,
         solver_device: xr.body.device(),
+        sim_mode: sim_mode.name().into(),
+        sim_mode_why,
         frames: outcome.frames,
         rendered: outcome.rendered,
         sim_frames: outcome.sim_frames,
@@ -259,11 +323,13 @@ fn run_session(
         dropped_time_s: outcome.dropped_time,
         display_hz: outcome.display_hz,
         dropped_frames: outcome.dropped_frames,
-        sim_steps_per_s: if outcome.wall_s > 0.0 {
-            outcome.sim_frames as f64 / outcome.wall_s
+        sim_steps_per_s: if outcome.sim_wall_s > 0.0 {
+            outcome.sim_frames as f64 / outcome.sim_wall_s
         } else {
             0.0
         },
+        tool_latency_ms_p50_p95: latency(0.5).zip(latency(0.95)),
+        slow_sim_ms: opts.slow_sim_ms,
         substeps: (xr.nominal_substeps(), outcome.min_substeps_used),
         frame_ms_p50_p95: quant(0.5).zip(quant(0.95)),
         solver_resets: outcome.solver_resets,
@@ -302,11 +368,19 @@ fn run_session(
 impl XrReport {
     /// One line for the terminal.
     pub fn summary(&self) -> String {
+        let latency = match self.tool_latency_ms_p50_p95 {
+            Some((p50, p95)) => format!("{p50:.0}/{p95:.0} ms"),
+            None => "-".into(),
+        };
         format!(
-            "{} display frames ({} rendered), {} simulation frames, {} tets released, tool force up to {:.2} N, exit {}",
+            "{} display frames ({} rendered, {} dropped), {} simulation frames ({:.1}/s, {}), tool-to-tissue latency p50/p95 {}, {} tets released, tool force up to {:.2} N, exit {}",
             self.frames,
             self.rendered,
+            self.dropped_frames,
             self.sim_frames,
+            self.sim_steps_per_s,
+            self.sim_mode,
+            latency,
             self.released_tets,
             self.max_tool_force,
             self.exit

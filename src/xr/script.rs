@@ -49,6 +49,12 @@ pub struct HeadsetScript {
     /// How substeps are paced.
     #[serde(default)]
     pub pacing: Pacing,
+    /// Run on the wall clock, as a runtime's frame loop does: each frame waits until its
+    /// display period begins, and a frame that comes late skips the refreshes it missed
+    /// (their display times are never shown). Off: a virtual clock, one period per frame
+    /// however long a frame takes (deterministic, faster or slower than real time).
+    #[serde(default)]
+    pub realtime: bool,
     /// Head poses in stage space (+y up, −z forward), m.
     pub head: Vec<StageKey>,
     /// The right controller (the scalpel); untracked outside its keys.

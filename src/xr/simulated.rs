@@ -5,6 +5,7 @@
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use anyhow::Result;
 use glam::Vec2;
@@ -34,6 +35,10 @@ pub struct SimulatedHeadset {
     textures: [wgpu::Texture; 2],
     views: [wgpu::TextureView; 2],
     frame: u64,
+    /// Display refresh of the frame begun last (= `frame` on the virtual clock).
+    refresh: u64,
+    /// When the wall clock started (a real-time script's first frame).
+    clock: Option<Instant>,
     lifecycle: Lifecycle,
     events: VecDeque<SessionPhase>,
     stopping: bool,
@@ -104,6 +109,8 @@ impl SimulatedHeadset {
             textures,
             views,
             frame: 0,
+            refresh: 0,
+            clock: None,
             lifecycle: Lifecycle::new(),
             events: VecDeque::from([
                 SessionPhase::Ready,
@@ -162,6 +169,34 @@ impl SimulatedHeadset {
             squeeze: track_at(&s.squeeze, t, 0.0),
             stick: track_at(&s.stick, t, Vec2::ZERO),
             menu: pressed(Button::Menu),
+        }
+    }
+
+    /// The display refresh the next frame is shown at. Virtual clock: the next one. Real
+    /// time: the next one whose period has not begun yet (a late frame skips those it
+    /// missed); refresh n's period is ((n − 1)·P, n·P], frame n renders in it.
+    fn upcoming_refresh(&self) -> u64 {
+        match (self.script.realtime, self.clock) {
+            (false, _) => self.frame,
+            (true, None) => 0,
+            (true, Some(clock)) => {
+                let now = clock.elapsed().as_secs_f64() / self.script.period();
+                (self.refresh + 1).max(now.floor() as u64 + 1)
+            }
+        }
+    }
+
+    /// Wait until refresh `n`'s period begins on the wall clock (as `xrWaitFrame` does;
+    /// the virtual clock does not wait).
+    fn wait_for(&mut self, n: u64) {
+        if !self.script.realtime {
+            return;
+        }
+        let clock = *self.clock.get_or_insert_with(Instant::now);
+        let begins = n.saturating_sub(1) as f64 * self.script.period();
+        let now = clock.elapsed().as_secs_f64();
+        if begins > now {
+            std::thread::sleep(Duration::from_secs_f64(begins - now));
         }
     }
 
@@ -239,7 +274,8 @@ impl Headset for SimulatedHeadset {
     }
 
     fn next_frame(&mut self) -> Result<FrameEvent, XrError> {
-        let t = self.frame as f64 * self.script.period();
+        let refresh = self.upcoming_refresh();
+        let t = refresh as f64 * self.script.period();
         // A failing runtime fails the wait for the next frame.
         self.check_failing("xrWaitFrame")?;
         if t >= self.script.duration {
@@ -258,6 +294,8 @@ impl Headset for SimulatedHeadset {
             return Ok(FrameEvent::Idle);
         }
         self.lifecycle.begin_frame()?;
+        self.wait_for(refresh);
+        self.refresh = refresh;
         let head = stage_pose_at(&self.script.head, t)
             .or_else(|| {
                 let last = self.script.head.last()?;

@@ -27,6 +27,21 @@ pub struct RenderDevice {
 }
 
 impl RenderDevice {
+    /// A second device, with its own queue, on the best adapter of wgpu's standard
+    /// instance (primary backends; honours `WGPU_BACKEND`): for compute that must not
+    /// share a queue with the headset's device. Not the window-less instance of
+    /// [`RenderDevice::headless`]: wgpu-hal enables the swapchain device extension
+    /// there without the instance's surface extension, which the Vulkan validation
+    /// layer reports as an error.
+    pub fn separate() -> Result<Self, RenderError> {
+        let primary = wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::PRIMARY,
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        }
+        .with_env();
+        pollster::block_on(Self::open(&wgpu::Instance::new(primary), None))
+    }
+
     /// Open a device without a window (offscreen rendering, benchmarks, tests). Honours
     /// `WGPU_BACKEND` and friends. Without it, Vulkan is opened without the window-system
     /// extensions first ([`crate::headless_vulkan`]), then the other primary backends

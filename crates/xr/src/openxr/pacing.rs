@@ -70,6 +70,12 @@ impl FramePacer {
         self.dropped
     }
 
+    /// Time until the next simulation frame is owed, s (0 when one is owed now): how
+    /// long a simulation thread paced to real time may sleep.
+    pub fn until_next_frame(&self) -> f64 {
+        (self.cfg.sim_dt - self.accumulator).max(0.0)
+    }
+
     /// Report the wall time `sim_wall_s` the last plan's `plan.sim_frames × plan.substeps`
     /// substeps took (exponentially smoothed, so one hiccup does not halve the substeps).
     pub fn record(&mut self, plan: FramePlan, sim_wall_s: f64) {
@@ -227,5 +233,19 @@ mod tests {
         for w in seen.windows(2) {
             assert!(w[1] >= w[0] && w[1] - w[0] <= (w[0] / 4).max(1), "{seen:?}");
         }
+    }
+
+    #[test]
+    fn until_next_frame_is_what_is_left_of_the_frame_not_yet_owed() {
+        let mut p = FramePacer::new(cfg());
+        let dt = 1.0 / 60.0;
+        // A quarter of a frame elapsed: none owed, three quarters to wait.
+        let plan = p.plan(0.25 * dt, 0.25 * dt);
+        assert_eq!(plan.sim_frames, 0);
+        assert!((p.until_next_frame() - 0.75 * dt).abs() < 1e-12);
+        // A frame and a half: one owed and stepped, half a frame to wait.
+        let plan = p.plan(1.5 * dt, 0.25 * dt);
+        assert_eq!(plan.sim_frames, 1);
+        assert!((p.until_next_frame() - 0.5 * dt).abs() < 1e-9);
     }
 }
