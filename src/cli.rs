@@ -315,6 +315,21 @@ pub enum ExperimentCommand {
         #[arg(long)]
         update: Option<PathBuf>,
     },
+    /// The substep budget of XPBD scenes: each run (cutting off) at the fewest substeps
+    /// the stability bound allows, at its own count and at a reference (≥ 200), with the
+    /// stress, displacement and volume errors against the reference; `--update FILE`
+    /// rewrites that table between its markers (docs/physics-notes.md).
+    Substeps {
+        /// Scenes to measure.
+        #[arg(default_values = ["config/plate_cut.ron", "config/slab_layer.ron", "config/intestine_pull.ron"])]
+        scenes: Vec<PathBuf>,
+        /// Frames per run.
+        #[arg(long, default_value_t = 60)]
+        frames: u32,
+        /// Rewrite the generated table in this document.
+        #[arg(long)]
+        update: Option<PathBuf>,
+    },
     /// Loop times of the mass-spring cutter on a chest-scale slab (18.5k nodes, 72k tets):
     /// levels 4 and 6, the whole mesh, the refresh-rate manager and the blade advances.
     NakaoBench {

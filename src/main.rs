@@ -285,6 +285,12 @@ fn main() -> ExitCode {
                 experiment::scene_figures::run(&scenes, update.as_deref())
                     .map(|table| print!("{table}"))
             }
+            ExperimentCommand::Substeps {
+                scenes,
+                frames,
+                update,
+            } => experiment::substep_budget::run(&scenes, frames, update.as_deref())
+                .map(|table| print!("{table}")),
             ExperimentCommand::NakaoBench {
                 loops,
                 budget_ms,
