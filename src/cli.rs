@@ -268,6 +268,11 @@ pub enum ExperimentCommand {
         /// Rheological preset file.
         #[arg(long, default_value = "config/rheology.ron")]
         presets: PathBuf,
+        /// Quick version (seconds, not minutes): every part on the coarse 40 × 40 × 20 cm
+        /// block of 10 cm cells, hold times 0.1 and 1 s, 2 s of sag. The figures in
+        /// docs/experiments/rheology/ come from the full version (without --quick).
+        #[arg(long)]
+        quick: bool,
     },
     /// Nakao 2003 plate (PHYSICS.md §2.6): the same straight cut at tension 0–6 %, adaptive
     /// and non-adaptive; writes table.md/.csv, results.json and PNG figures.
@@ -275,6 +280,11 @@ pub enum ExperimentCommand {
         /// Output folder.
         #[arg(long)]
         out: PathBuf,
+        /// Quick version (seconds, not minutes): a 4 cm cut instead of 14 cm at 0 and 4 %
+        /// tension, adaptive and non-adaptive, 0.2 s for the wound to open. The figures in
+        /// docs/experiments/nakao/ come from the full version (without --quick).
+        #[arg(long)]
+        quick: bool,
     },
     /// Nakao 2003 chest (PHYSICS.md §2.6, Figs. 15–17): an incision along the sternum of a
     /// torso-like chest (the paper's 17,582 nodes) at levels 4, 6 and with the refresh-rate

@@ -253,12 +253,18 @@ fn main() -> ExitCode {
         Command::Results { history } => exercise::read_history(&history)
             .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {
-            ExperimentCommand::Rheology { out, presets } => {
-                experiment::rheology::run(&experiment::rheology::RheologyOptions { out, presets })
-                    .map(|summary| print!("{summary}"))
-            }
-            ExperimentCommand::NakaoPlate { out } => {
-                experiment::nakao::run(&experiment::nakao::NakaoOptions { out })
+            ExperimentCommand::Rheology {
+                out,
+                presets,
+                quick,
+            } => experiment::rheology::run(&experiment::rheology::RheologyOptions {
+                out,
+                presets,
+                quick,
+            })
+            .map(|summary| print!("{summary}")),
+            ExperimentCommand::NakaoPlate { out, quick } => {
+                experiment::nakao::run(&experiment::nakao::NakaoOptions { out, quick })
                     .map(|table| print!("{table}"))
             }
             ExperimentCommand::NakaoChest { out, loops } => {
