@@ -178,7 +178,13 @@ pub enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Frames to time per case (after 2 warm-up frames).
+        /// Solver target: print the table as the markdown rows of docs/performance.md,
+        /// under a line giving the command, machine (CPU model, cores), UTC date and load
+        /// average.
+        #[arg(long, conflicts_with = "json")]
+        markdown: bool,
+        /// Frames to time per case (after 2 warm-up frames; the solver target interleaves
+        /// its variants frame by frame).
         #[arg(long, default_value_t = 10)]
         frames: u32,
         /// Which cases to run.
@@ -211,6 +217,10 @@ pub enum Command {
         /// Output folder for soak.json.
         #[arg(long, default_value = "out/soak")]
         out: PathBuf,
+        /// Also print the result as a row of docs/reliability.md's soak table, under a
+        /// line giving the command, machine (CPU model, cores), UTC date and load average.
+        #[arg(long)]
+        markdown: bool,
     },
     /// Score a stroke on a training exercise: runs the exercise's scene with the stroke
     /// driving the scalpel, writes DIR/result.json and DIR/report.html and appends the

@@ -184,13 +184,22 @@ fn main() -> ExitCode {
             case,
             device,
             scaling,
+            markdown,
             ..
-        } => bench::run(case, frames, json, device, scaling),
+        } => {
+            let output = match (json, markdown) {
+                (true, _) => bench::BenchOutput::Json,
+                (_, true) => bench::BenchOutput::Markdown,
+                _ => bench::BenchOutput::Table,
+            };
+            bench::run(case, frames, output, device, scaling)
+        }
         Command::Soak {
             scene,
             seconds,
             device,
             out,
+            markdown,
         } => incise::soak::run(&incise::soak::SoakOptions {
             scene,
             seconds,
@@ -211,6 +220,9 @@ fn main() -> ExitCode {
                 if r.problems.iter().any(|p| p.contains("other tets")) { "differs from" } else { "matches" },
             );
             println!("report: {}", out.join("soak.json").display());
+            if markdown {
+                print!("\n{}", incise::soak::markdown(&r));
+            }
             if r.passed {
                 Ok(())
             } else {

@@ -94,7 +94,7 @@ pub fn run(opts: &NakaoOptions) -> Result<String> {
                 .with_context(|| format!("plate cut at tension {}", s.tension))
         })
         .collect::<Result<_>>()?;
-    let prov = super::nakao_chest::provenance();
+    let prov = crate::provenance::provenance();
     let version = if opts.quick {
         "Quick version (`--quick`: 4 cm cut, 0.2 s to open). "
     } else {
