@@ -313,7 +313,7 @@ pub enum ExperimentCommand {
     /// between its markers in FILE (docs/performance.md).
     SceneFigures {
         /// Scenes to run to their end.
-        #[arg(default_values = ["config/plate_cut.ron", "config/slab_layer.ron"])]
+        #[arg(default_values = ["config/plate_cut.ron", "config/slab_layer.ron", "config/intestine_incision.ron"])]
         scenes: Vec<PathBuf>,
         /// Rewrite the generated table in this document.
         #[arg(long)]
