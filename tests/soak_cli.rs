@@ -3,8 +3,8 @@
 //! 10 s a cut) on the CPU and on the GPU (lavapipe in CI); memory stays within 5 % after
 //! the warm-up cut, no file descriptor leaks, every cut releases exactly the first cut's
 //! tets, and `--markdown` prints that as a table row under its provenance line.
-//! `INCISE_SOAK_SECONDS` sets a longer duration per device (it was 150 s each, 5 of
-//! CI's 30 minutes, for the same checks).
+//! `INCISE_SOAK_SECONDS` sets a longer duration per device (it was 150 s each, the two
+//! side by side: 2.5 of CI's 30 minutes, for the same checks).
 
 mod common;
 
