@@ -70,14 +70,59 @@ pub struct BenchReport {
     pub results: Vec<BenchResult>,
 }
 
-/// Run the benchmark and print a table or one JSON object.
+/// How `incise bench` prints its results.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BenchOutput {
+    /// An aligned text table.
+    Table,
+    /// One JSON object.
+    Json,
+    /// The rows of docs/performance.md's CPU solver table, under a header naming the
+    /// command, machine, date and load average.
+    Markdown,
+}
+
+/// Run the benchmark and print its results in `output`'s form.
 pub fn run(
     case: BenchCase,
     frames: u32,
-    json: bool,
+    output: BenchOutput,
     device: DeviceChoice,
     scaling: bool,
 ) -> Result<()> {
+    let all = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut results = Vec::new();
+    for (name, raw) in cases(case, scaling) {
+        let (mesh, _) = TetMesh::from_raw(raw)?;
+        let configs: Vec<(usize, DeviceChoice)> = match device {
+            DeviceChoice::Cpu if all > 1 => vec![(1, DeviceChoice::Cpu), (all, DeviceChoice::Cpu)],
+            d => vec![(1, d)],
+        };
+        let mut variants = configs
+            .into_iter()
+            .map(|(threads, d)| Variant::new(&name, mesh.clone(), threads, d))
+            .collect::<Result<Vec<_>>>()?;
+        for r in time_interleaved(&mut variants, frames)? {
+            if output == BenchOutput::Table {
+                print_row(&r, results.is_empty());
+            }
+            results.push(r);
+        }
+    }
+    let report = BenchReport {
+        machine: machine(),
+        results,
+    };
+    match output {
+        BenchOutput::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        BenchOutput::Table => println!("machine: {}", report.machine),
+        BenchOutput::Markdown => print!("{}", markdown(&report.results, frames)),
+    }
+    Ok(())
+}
+
+/// The meshes of `case`, and the scaling series with `scaling`.
+fn cases(case: BenchCase, scaling: bool) -> Vec<(String, RawMesh)> {
     let mut cases: Vec<(String, RawMesh)> = Vec::new();
     if matches!(case, BenchCase::All | BenchCase::Plate) {
         cases.push(("plate".into(), generate::plate()));
@@ -97,114 +142,173 @@ pub fn run(
             ));
         }
     }
-    let all = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut results = Vec::new();
-    for (name, raw) in cases {
-        let (mesh, _) = TetMesh::from_raw(raw)?;
-        let configs: Vec<(usize, DeviceChoice)> = match device {
-            DeviceChoice::Cpu => {
-                let mut t = vec![(1, DeviceChoice::Cpu)];
-                if all > 1 {
-                    t.push((all, DeviceChoice::Cpu));
-                }
-                t
-            }
-            d => vec![(1, d)],
-        };
-        for (threads, d) in configs {
-            let r = time_case(&name, mesh.clone(), threads, d, frames)?;
-            if !json {
-                print_row(&r, results.is_empty());
-            }
-            results.push(r);
-        }
-    }
-    let report = BenchReport {
-        machine: machine(),
-        results,
-    };
-    if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        println!("machine: {}", report.machine);
-    }
-    Ok(())
+    cases
 }
 
-/// Time `frames` frames (10 substeps each) of a body hanging from one end under gravity,
-/// after 2 warm-up frames.
-fn time_case(
-    name: &str,
-    mesh: TetMesh,
-    threads: usize,
-    device: DeviceChoice,
-    frames: u32,
-) -> Result<BenchResult> {
-    let mut params = SolverParams {
-        threads,
-        substeps: BENCH_SUBSTEPS,
-        ..SolverParams::default()
-    };
-    let w: Vec<f32> = mesh
-        .lumped_masses(BOWEL.density)
-        .iter()
-        .map(|&m| 1.0 / m)
-        .collect();
-    let (kappa, _) = stiffness_number(&mesh, &w, BOWEL.lame(), params.substep());
-    // κ ∝ E: soften just enough (2 % margin) for 10 substeps to be stable.
-    let material = Material {
-        youngs_modulus: BOWEL.youngs_modulus * (0.98 / kappa).min(1.0),
-        ..BOWEL
-    };
-    params.substeps = BENCH_SUBSTEPS;
-    let (lo, hi) = mesh.rest_bounds();
-    let (tets, nodes) = (mesh.tet_count(), mesh.node_count());
-    let mut solver = Solver::new(mesh, material, params)?;
-    let rest = solver.mesh().rest_positions.clone();
-    let pins = NodeSelection::PlaneSide {
-        point: lo + (hi - lo) * 0.05,
-        normal: -glam::Vec3::X,
+/// One configuration to time (a mesh on a device with a thread count), warmed up, and
+/// the samples taken so far.
+struct Variant {
+    result: BenchResult,
+    body: Body,
+    solve: Vec<f64>,
+    frame: Vec<f64>,
+    stress: Vec<f64>,
+    gpu: Vec<f64>,
+}
+
+impl Variant {
+    /// A body hanging from one end under gravity, 10 substeps per frame, after 2 warm-up
+    /// frames.
+    fn new(name: &str, mesh: TetMesh, threads: usize, device: DeviceChoice) -> Result<Self> {
+        let params = SolverParams {
+            threads,
+            substeps: BENCH_SUBSTEPS,
+            ..SolverParams::default()
+        };
+        let w: Vec<f32> = mesh
+            .lumped_masses(BOWEL.density)
+            .iter()
+            .map(|&m| 1.0 / m)
+            .collect();
+        let (kappa, _) = stiffness_number(&mesh, &w, BOWEL.lame(), params.substep());
+        // κ ∝ E: soften just enough (2 % margin) for 10 substeps to be stable.
+        let material = Material {
+            youngs_modulus: BOWEL.youngs_modulus * (0.98 / kappa).min(1.0),
+            ..BOWEL
+        };
+        let (lo, hi) = mesh.rest_bounds();
+        let (tets, nodes) = (mesh.tet_count(), mesh.node_count());
+        let mut solver = Solver::new(mesh, material, params)?;
+        let rest = solver.mesh().rest_positions.clone();
+        let pins = NodeSelection::PlaneSide {
+            point: lo + (hi - lo) * 0.05,
+            normal: -glam::Vec3::X,
+        }
+        .select(&rest)?;
+        solver.pin(&pins);
+        let colors = solver.color_count();
+        let mut body = Body::place(solver, device, |m| eprintln!("note: {m}"))?;
+        for _ in 0..2 {
+            body.step_frame()?;
+        }
+        let result = BenchResult {
+            case: name.into(),
+            tets,
+            nodes,
+            colors,
+            threads: if matches!(body, Body::Gpu(_)) {
+                0
+            } else {
+                threads
+            },
+            device: body.device(),
+            substeps: BENCH_SUBSTEPS,
+            youngs_modulus: material.youngs_modulus,
+            bowel_substeps_needed: substeps_needed(kappa, BENCH_SUBSTEPS).max(BENCH_SUBSTEPS),
+            ms_per_substep_median: 0.0,
+            ms_per_substep_min: 0.0,
+            ms_per_frame_median: 0.0,
+            gpu_ms_per_frame_median: None,
+            stress_ms_median: 0.0,
+            peak_mib: 0.0,
+        };
+        Ok(Variant {
+            result,
+            body,
+            solve: Vec::new(),
+            frame: Vec::new(),
+            stress: Vec::new(),
+            gpu: Vec::new(),
+        })
     }
-    .select(&rest)?;
-    solver.pin(&pins);
-    let colors = solver.color_count();
-    let mut body = Body::place(solver, device, |m| eprintln!("note: {m}"))?;
-    for _ in 0..2 {
-        body.step_frame()?;
-    }
-    let (mut solve, mut frame, mut stress, mut gpu) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for _ in 0..frames.max(1) {
+
+    /// Time one frame.
+    fn sample(&mut self) -> Result<()> {
         let t = Instant::now();
-        let s = body.step_frame()?;
-        frame.push(t.elapsed().as_secs_f64() * 1e3);
-        solve.push(s.solve_ms / s.substeps as f64);
-        stress.push(s.stress_ms);
-        if let Some(g) = body.gpu_frame_ms() {
-            gpu.push(g);
+        let s = self.body.step_frame()?;
+        self.frame.push(t.elapsed().as_secs_f64() * 1e3);
+        self.solve.push(s.solve_ms / s.substeps as f64);
+        self.stress.push(s.stress_ms);
+        if let Some(g) = self.body.gpu_frame_ms() {
+            self.gpu.push(g);
+        }
+        Ok(())
+    }
+
+    /// The result with its medians and minimum.
+    fn finish(mut self) -> BenchResult {
+        let mut r = self.result;
+        r.ms_per_substep_median = median(&mut self.solve);
+        r.ms_per_substep_min = self.solve.iter().copied().fold(f64::INFINITY, f64::min);
+        r.ms_per_frame_median = median(&mut self.frame);
+        r.gpu_ms_per_frame_median = (!self.gpu.is_empty()).then(|| median(&mut self.gpu));
+        r.stress_ms_median = median(&mut self.stress);
+        r.peak_mib = peak_mib();
+        r
+    }
+}
+
+/// Time `frames` frames of every variant, interleaved frame by frame (variant 1, 2, 1,
+/// 2, …) so that a change of the machine's load falls on all of them alike.
+fn time_interleaved(variants: &mut Vec<Variant>, frames: u32) -> Result<Vec<BenchResult>> {
+    for _ in 0..frames.max(1) {
+        for v in variants.iter_mut() {
+            v.sample()?;
         }
     }
-    Ok(BenchResult {
-        case: name.into(),
-        tets,
-        nodes,
-        colors,
-        threads: if matches!(body, Body::Gpu(_)) {
-            0
-        } else {
-            threads
-        },
-        device: body.device(),
-        substeps: BENCH_SUBSTEPS,
-        youngs_modulus: material.youngs_modulus,
-        bowel_substeps_needed: substeps_needed(kappa, BENCH_SUBSTEPS).max(BENCH_SUBSTEPS),
-        ms_per_substep_median: median(&mut solve),
-        ms_per_substep_min: solve.iter().copied().fold(f64::INFINITY, f64::min),
-        ms_per_frame_median: median(&mut frame),
-        gpu_ms_per_frame_median: (!gpu.is_empty()).then(|| median(&mut gpu)),
-        stress_ms_median: median(&mut stress),
-        peak_mib: peak_mib(),
-    })
+    Ok(variants.drain(..).map(Variant::finish).collect())
+}
+
+/// The results as docs/performance.md's CPU solver table, under a header saying how,
+/// where and when they were measured.
+pub fn markdown(results: &[BenchResult], frames: u32) -> String {
+    let p = crate::provenance::provenance();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut s = format!(
+        "{MARKDOWN_HEADER} {}`: release build; frames of {BENCH_SUBSTEPS} substeps, the \
+         small-bowel material softened to the {BENCH_SUBSTEPS}-substep stability bound, the \
+         body hanging from one end under gravity; {frames} frames per variant after 2 \
+         warm-up, the variants interleaved frame by frame; {}, {}, load average {}.\n\n\
+         | case | tets | nodes | colours | threads | ms / substep (median) | min | ms / frame ({BENCH_SUBSTEPS} substeps) | stress pass ms / frame | peak MiB (process) |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+        args.get(1..).unwrap_or_default().join(" "),
+        p.machine,
+        p.date_utc,
+        p.load_average
+    );
+    for r in results {
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} |\n",
+            r.case,
+            thousands(r.tets),
+            thousands(r.nodes),
+            r.colors,
+            r.threads,
+            r.ms_per_substep_median,
+            r.ms_per_substep_min,
+            r.ms_per_frame_median,
+            r.stress_ms_median,
+            r.peak_mib
+        ));
+    }
+    s
+}
+
+/// How every `--markdown` table begins, followed by the rest of the command line and
+/// where and when it ran (tests/docs_figures.rs looks for it).
+pub const MARKDOWN_HEADER: &str = "Generated by `incise bench";
+
+/// `n` with thousands separated by commas (34,176).
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }
 
 fn print_row(r: &BenchResult, header: bool) {

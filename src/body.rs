@@ -177,3 +177,36 @@ impl Body {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An adapter of `device_type` named `name` (no real device needed).
+    fn adapter(name: &str, device_type: wgpu::DeviceType) -> wgpu::AdapterInfo {
+        wgpu::AdapterInfo {
+            name: name.into(),
+            ..wgpu::AdapterInfo::new(device_type, wgpu::Backend::Vulkan)
+        }
+    }
+
+    /// Every kind of adapter, also those CI never has (a hardware GPU): a software one
+    /// gets the CPU solver, any hardware one the GPU, and the reason names the adapter.
+    #[test]
+    fn auto_device_picks_the_cpu_only_for_a_software_adapter() {
+        use wgpu::DeviceType::*;
+        for (kind, pick, word) in [
+            (Cpu, DeviceChoice::Cpu, "software"),
+            (DiscreteGpu, DeviceChoice::Gpu, "hardware"),
+            (IntegratedGpu, DeviceChoice::Gpu, "hardware"),
+            (VirtualGpu, DeviceChoice::Gpu, "hardware"),
+        ] {
+            let (got, why) = auto_device(&adapter("Test Adapter 9", kind));
+            assert_eq!(got, pick, "{kind:?}: {why}");
+            assert!(
+                why.contains(word) && why.contains("Test Adapter 9"),
+                "{kind:?}: {why}"
+            );
+        }
+    }
+}

@@ -191,7 +191,13 @@ pub enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Frames to time per case (after 2 warm-up frames).
+        /// Solver target: print the table as the markdown rows of docs/performance.md,
+        /// under a line giving the command, machine (CPU model, cores), UTC date and load
+        /// average.
+        #[arg(long, conflicts_with = "json")]
+        markdown: bool,
+        /// Frames to time per case (after 2 warm-up frames; the solver target interleaves
+        /// its variants frame by frame).
         #[arg(long, default_value_t = 10)]
         frames: u32,
         /// Which cases to run.
@@ -227,6 +233,10 @@ pub enum Command {
         /// Output folder for soak.json.
         #[arg(long, default_value = "out/soak")]
         out: PathBuf,
+        /// Also print the result as a row of docs/reliability.md's soak table, under a
+        /// line giving the command, machine (CPU model, cores), UTC date and load average.
+        #[arg(long)]
+        markdown: bool,
     },
     /// Score a stroke on a training exercise: runs the exercise's scene with the stroke
     /// driving the scalpel, writes DIR/result.json and DIR/report.html and appends the
@@ -284,6 +294,11 @@ pub enum ExperimentCommand {
         /// Rheological preset file.
         #[arg(long, default_value = "config/rheology.ron")]
         presets: PathBuf,
+        /// Quick version (seconds, not minutes): every part on the coarse 40 × 40 × 20 cm
+        /// block of 10 cm cells, hold times 0.1 and 1 s, 2 s of sag. The figures in
+        /// docs/experiments/rheology/ come from the full version (without --quick).
+        #[arg(long)]
+        quick: bool,
     },
     /// Nakao 2003 plate (PHYSICS.md §2.6): the same straight cut at tension 0–6 %, adaptive
     /// and non-adaptive; writes table.md/.csv, results.json and PNG figures.
@@ -291,6 +306,11 @@ pub enum ExperimentCommand {
         /// Output folder.
         #[arg(long)]
         out: PathBuf,
+        /// Quick version (seconds, not minutes): a 4 cm cut instead of 14 cm at 0 and 4 %
+        /// tension, adaptive and non-adaptive, 0.2 s for the wound to open. The figures in
+        /// docs/experiments/nakao/ come from the full version (without --quick).
+        #[arg(long)]
+        quick: bool,
     },
     /// Nakao 2003 chest (PHYSICS.md §2.6, Figs. 15–17): an incision along the sternum of a
     /// torso-like chest (the paper's 17,582 nodes) at levels 4, 6 and with the refresh-rate
@@ -309,7 +329,7 @@ pub enum ExperimentCommand {
     /// between its markers in FILE (docs/performance.md).
     SceneFigures {
         /// Scenes to run to their end.
-        #[arg(default_values = ["config/plate_cut.ron", "config/slab_layer.ron"])]
+        #[arg(default_values = ["config/plate_cut.ron", "config/slab_layer.ron", "config/intestine_incision.ron"])]
         scenes: Vec<PathBuf>,
         /// Rewrite the generated table in this document.
         #[arg(long)]

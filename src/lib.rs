@@ -16,6 +16,7 @@ pub mod mesh_cmd;
 pub mod plot;
 pub mod preview;
 pub mod progress;
+pub mod provenance;
 pub mod report;
 pub mod run;
 pub mod run_mass_spring;

@@ -197,13 +197,22 @@ fn main() -> ExitCode {
             case,
             device,
             scaling,
+            markdown,
             ..
-        } => bench::run(case, frames, json, device, scaling),
+        } => {
+            let output = match (json, markdown) {
+                (true, _) => bench::BenchOutput::Json,
+                (_, true) => bench::BenchOutput::Markdown,
+                _ => bench::BenchOutput::Table,
+            };
+            bench::run(case, frames, output, device, scaling)
+        }
         Command::Soak {
             scene,
             seconds,
             device,
             out,
+            markdown,
         } => incise::soak::run(&incise::soak::SoakOptions {
             scene,
             seconds,
@@ -224,6 +233,9 @@ fn main() -> ExitCode {
                 if r.problems.iter().any(|p| p.contains("other tets")) { "differs from" } else { "matches" },
             );
             println!("report: {}", out.join("soak.json").display());
+            if markdown {
+                print!("\n{}", incise::soak::markdown(&r));
+            }
             if r.passed {
                 Ok(())
             } else {
@@ -266,12 +278,18 @@ fn main() -> ExitCode {
         Command::Results { history } => exercise::read_history(&history)
             .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {
-            ExperimentCommand::Rheology { out, presets } => {
-                experiment::rheology::run(&experiment::rheology::RheologyOptions { out, presets })
-                    .map(|summary| print!("{summary}"))
-            }
-            ExperimentCommand::NakaoPlate { out } => {
-                experiment::nakao::run(&experiment::nakao::NakaoOptions { out })
+            ExperimentCommand::Rheology {
+                out,
+                presets,
+                quick,
+            } => experiment::rheology::run(&experiment::rheology::RheologyOptions {
+                out,
+                presets,
+                quick,
+            })
+            .map(|summary| print!("{summary}")),
+            ExperimentCommand::NakaoPlate { out, quick } => {
+                experiment::nakao::run(&experiment::nakao::NakaoOptions { out, quick })
                     .map(|table| print!("{table}"))
             }
             ExperimentCommand::NakaoChest { out, loops } => {

@@ -209,3 +209,35 @@ pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
         .with_context(|| format!("writing {}", path.display()))?;
     Ok(report)
 }
+
+/// The report as one row of docs/reliability.md's soak table, under the line saying
+/// which command made it, where and when.
+pub fn markdown(r: &SoakReport) -> String {
+    let mib = |kib: u64| kib as f64 / 1024.0;
+    let (second, last) = (&r.cycles[1], r.cycles.last().unwrap_or(&r.cycles[1]));
+    let mut p50: Vec<f64> = r.cycles.iter().map(|c| c.p50_ms).collect();
+    let mut p99: Vec<f64> = r.cycles.iter().map(|c| c.p99_ms).collect();
+    p50.sort_by(f64::total_cmp);
+    p99.sort_by(f64::total_cmp);
+    let released: Vec<usize> = r.cycles.iter().map(|c| c.released).collect();
+    let identical = if r.cycles.iter().all(|c| c.matches_first) {
+        format!("{} tets every cut", released[0])
+    } else {
+        format!("no: {released:?}")
+    };
+    format!(
+        "{}\n\n| device | cuts | RSS after cut 2 → end | sustained growth | peak | descriptors | cuts identical | p50 / p99 frame (median over cuts) |\n|---|---|---|---|---|---|---|---|\n| {} | {} in {:.0} s | {:.2} → {:.2} MiB | {:+.1} % | {:+.1} % | {} → {} | {identical} | {:.0} / {:.0} ms |\n",
+        crate::provenance::generated_by(),
+        r.device,
+        r.cycles.len(),
+        r.seconds,
+        mib(second.rss_kib),
+        mib(last.rss_kib),
+        r.rss_growth * 100.0,
+        r.rss_peak_growth * 100.0,
+        second.open_fds,
+        last.open_fds,
+        p50[p50.len() / 2],
+        p99[p99.len() / 2],
+    )
+}

@@ -112,6 +112,29 @@ fn each_part_loses_points_in_proportion_to_its_tolerance() {
     );
     assert!((v.parts.collateral - 7.5).abs() < 1e-6);
     assert!(!check(&v, "collateral").passed);
+    // Half the 2.5 mm depth tolerance off the target: half the 20 depth points (the
+    // depth tolerance, not the 3 mm lateral one), still within the 2.5 mm allowed.
+    let v = judge(
+        &ex.exercise,
+        &Metrics {
+            mean_depth_error: Some(0.00125),
+            ..perfect()
+        },
+    );
+    assert!((v.parts.depth - 10.0).abs() < 1e-6, "{:?}", v.parts);
+    assert!((v.score - 90.0).abs() < 1e-6, "{}", v.score);
+    assert!(check(&v, "depth_error").passed);
+    assert!(check(&v, "depth_error").detail.contains("1.2 mm"));
+    // 3 mm off: no depth points, and the 2.5 mm condition fails.
+    let v = judge(
+        &ex.exercise,
+        &Metrics {
+            mean_depth_error: Some(0.003),
+            ..perfect()
+        },
+    );
+    assert_eq!(v.parts.depth, 0.0, "{:?}", v.parts);
+    assert!(!check(&v, "depth_error").passed);
     // Through the slab: deeper than 3 + 2.5 mm fails max_depth.
     let v = judge(
         &ex.exercise,
@@ -196,6 +219,28 @@ fn metrics_of_a_hand_made_cut_along_the_plan() {
         m.mean_depth_error
     );
     assert_eq!(m.collateral_volume, 0.0);
+    // The bottom layer under the plan, released from below: its faces on the table side
+    // face away from the plan's surface, so they leave no trace on it (nothing of the
+    // plan is cut), and 7 mm deep they are all collateral.
+    let below =
+        |c: DVec3| (c.y - 0.02).abs() < 0.0015 && (0.025..0.055).contains(&c.x) && c.z < 0.002;
+    let under: Vec<bool> = (0..n).map(|t| below(centroid(&ex, t))).collect();
+    let mb = compute_metrics(&ex.exercise, &ex.plan, &ex.mesh, &under, &[], 1.0 / 60.0);
+    let under_volume: f64 = (0..n)
+        .filter(|&t| under[t])
+        .map(|t| ex.mesh.rest_volume[t] as f64)
+        .sum();
+    assert!(mb.released_tets > 0);
+    assert_eq!(
+        (mb.trace_faces, mb.completion, mb.mean_deviation),
+        (0, 0.0, None),
+        "faces on the far side counted as the trace"
+    );
+    assert!(
+        (mb.collateral_volume - under_volume).abs() < 1e-12,
+        "{}",
+        mb.collateral_volume
+    );
     // Tets 1 cm to the side are collateral, volume for volume.
     let aside =
         |c: DVec3| (c.y - 0.03).abs() < 0.0015 && (0.025..0.035).contains(&c.x) && c.z > 0.006;

@@ -2,6 +2,8 @@
 //! experiment rheology` and `experiment nakao-plate` write their tables and figures, and
 //! the figures say what the papers' experiments show; `incise bench render` (one frame,
 //! the plate) honours `--case`, `--device` and `--scaling`-less runs in its JSON.
+//! The full-size experiments take minutes (ignored here); their `--quick` versions run in
+//! seconds and are checked against the closed form and the plate's geometry.
 
 mod common;
 
@@ -116,6 +118,187 @@ fn experiment_nakao_plate_writes_its_table_and_results() {
             .extension()
             .is_some_and(|x| x == "png")),
         "no figure"
+    );
+}
+
+/// The rows of a CSV file with a header, every cell a number or a name.
+fn csv_rows(path: &std::path::Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+/// The number in `cell`.
+fn num(cell: &str) -> f64 {
+    cell.parse()
+        .unwrap_or_else(|_| panic!("`{cell}` is not a number"))
+}
+
+/// One element under F = 0.5 N for 1 s (k 100 N/m, c1 5, c2 50 N·s/m, PHYSICS.md §3):
+/// `u = F/k (1 − e^{−kt/c1}) + F t/c2`, then the Voigt part relaxes and `F t1/c2` stays.
+fn creep_closed_form(t: f64) -> f64 {
+    let (k, c1, c2, f, t1) = (100.0f64, 5.0, 50.0, 0.5, 1.0);
+    let voigt = |t: f64| f / k * (1.0 - (-k * t / c1).exp());
+    if t <= t1 {
+        voigt(t) + f * t / c2
+    } else {
+        voigt(t1) * (-k * (t - t1) / c1).exp() + f * t1 / c2
+    }
+}
+
+/// `incise experiment rheology --quick`: the creep curve follows the closed form (0.1 %
+/// of the 15 mm peak, written out here, not the program's own function), the presets
+/// do what PHYSICS.md §3 says (viscoelastic returns, plastic keeps the dent, rheological
+/// keeps part of it, more the longer it is held) and the force-dependent damper keeps
+/// the block's shape under gravity.
+#[test]
+fn quick_rheology_matches_the_closed_form_and_the_presets() {
+    let out = temp_dir("exp-rheology-quick");
+    let o = incise(&[
+        "experiment",
+        "rheology",
+        "--quick",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let printed = text(&o.stdout);
+    assert_eq!(
+        printed,
+        std::fs::read_to_string(out.join("summary.txt")).unwrap()
+    );
+    // Creep: every sample within 0.1 % of the peak; the peak 15 mm at release and the
+    // damper's 10 mm residual at 3 s.
+    let creep: Vec<Vec<f64>> = csv_rows(&out.join("creep.csv"))
+        .iter()
+        .map(|r| r.iter().map(|c| num(c)).collect())
+        .collect();
+    assert!(creep.len() > 500, "{} creep rows", creep.len());
+    // (Times are written to 1 µs; at the curve's steepest, 0.11 m/s, that is 1.1e-7 m.)
+    for r in &creep {
+        let exact = creep_closed_form(r[0]);
+        assert!(
+            (r[2] - exact).abs() < 2e-7 && (r[1] - exact).abs() < 1e-3 * 0.015,
+            "creep at t = {} s: simulated {} m, closed form {exact} m",
+            r[0],
+            r[1]
+        );
+    }
+    let at = |t: f64| {
+        creep
+            .iter()
+            .min_by(|a, b| (a[0] - t).abs().total_cmp(&(b[0] - t).abs()))
+            .unwrap()[1]
+    };
+    assert!((at(1.0) - 0.015).abs() < 1e-4, "peak {} m", at(1.0));
+    assert!((at(3.0) - 0.010).abs() < 1e-4, "residual {} m", at(3.0));
+    // Press and release of the block, 20 % of its height (40 mm).
+    let press = csv_rows(&out.join("press_summary.csv"));
+    let residual = |name: &str| {
+        let row = press
+            .iter()
+            .find(|r| r[0] == name)
+            .unwrap_or_else(|| panic!("no {name} row: {press:?}"));
+        assert!(
+            (num(&row[1]) - 40.0).abs() < 1.0,
+            "{name} pressed {}",
+            row[1]
+        );
+        num(&row[3])
+    };
+    assert!(residual("viscoelastic").abs() < 0.01, "{press:?}");
+    assert!(residual("plastic") > 0.95, "{press:?}");
+    let rheological = residual("rheological");
+    assert!((0.2..0.8).contains(&rheological), "{press:?}");
+    assert!(residual("elastic").abs() < 0.1, "{press:?}");
+    let holds = csv_rows(&out.join("hold_time.csv"));
+    let (short, long) = (num(&holds[0][3]), num(&holds[holds.len() - 1][3]));
+    assert!(short < rheological && rheological < long, "{holds:?}");
+    // Gravity: the force-dependent damper sags less than a tenth of its linear twin.
+    let sag = csv_rows(&out.join("gravity_sag.csv"));
+    let last = sag.last().unwrap();
+    assert!((num(&last[0]) - 2.0).abs() < 1e-9, "{last:?}");
+    assert!(
+        num(&last[1]) > 0.0 && num(&last[1]) < 0.1 * num(&last[2]),
+        "{last:?}"
+    );
+    assert!(printed.contains("gravity sag over 2 s"), "{printed}");
+}
+
+/// `incise experiment nakao-plate --quick`: the plate before the cut is the generated
+/// 24 × 24 × 1 Kuhn grid (25² × 2 nodes, 24² × 6 tets); the 4 cm cut adds nodes and
+/// tets, the non-adaptive split more of them and worse tets than the adaptive one; the
+/// cut surface (both sides) is 2 × length × 4 mm thick, give or take the cells at its
+/// ends; the wound opens under 4 % tension and not without it.
+#[test]
+fn quick_nakao_plate_cuts_the_plate_as_its_geometry_says() {
+    let out = temp_dir("exp-nakao-quick");
+    let o = incise(&[
+        "experiment",
+        "nakao-plate",
+        "--quick",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let printed = text(&o.stdout);
+    assert_eq!(
+        printed,
+        std::fs::read_to_string(out.join("table.md")).unwrap()
+    );
+    assert!(printed.starts_with("Quick version"), "{printed}");
+    let rows = csv_rows(&out.join("table.csv"));
+    let case = |sub: &str, tension: f64| {
+        rows.iter()
+            .find(|r| r[0] == sub && num(&r[1]) == tension)
+            .unwrap_or_else(|| panic!("no {sub} {tension} row: {rows:?}"))
+    };
+    let (length, thickness, cell) = (0.04, 0.004, 0.16 / 24.0);
+    let (lo, hi) = (
+        2.0 * (length - 2.0 * cell) * thickness,
+        2.0 * (length + cell) * thickness,
+    );
+    for (sub, tension) in [
+        ("adaptive", 0.0),
+        ("adaptive", 0.04),
+        ("non-adaptive", 0.04),
+    ] {
+        let r = case(sub, tension);
+        let n: Vec<f64> = r[2..10].iter().map(|c| num(c)).collect();
+        assert_eq!(
+            [n[0], n[6]],
+            [1250.0, 3456.0],
+            "{sub} {tension}: the plate before the cut"
+        );
+        assert!(
+            n[1] > n[0] && n[7] > n[6],
+            "{sub} {tension}: nothing added: {r:?}"
+        );
+        let area = num(&r[10]);
+        assert!(
+            (lo..hi).contains(&area),
+            "{sub} {tension}: cut area {area} m², expected {lo}..{hi}"
+        );
+        let opening = num(&r[11]);
+        if tension == 0.0 {
+            assert!(opening < 5e-5, "opened without tension: {opening} m");
+        } else {
+            // Millimetres: a wound held open by the tension, not a tear across the plate.
+            assert!(
+                (1e-3..1e-2).contains(&opening),
+                "{sub}: opening {opening} m"
+            );
+        }
+    }
+    let (a, na) = (case("adaptive", 0.04), case("non-adaptive", 0.04));
+    let added = |r: &Vec<String>| num(&r[9]) - num(&r[8]);
+    assert!(added(na) > added(a), "non-adaptive {na:?}, adaptive {a:?}");
+    assert!(
+        num(&na[14]) < num(&a[14]),
+        "worst dihedral: {na:?} vs {a:?}"
     );
 }
 

@@ -13,6 +13,8 @@ use incise_sim::nakao_cut::measure::MeshCounts;
 use incise_sim::nakao_cut::{ChestLoop, ChestRun, chest_model, run_chest_cut};
 use serde::Serialize;
 
+use crate::provenance::{Provenance, provenance};
+
 /// The paper's chest (nodes, edges, surface triangles, tets).
 pub const PAPER_CHEST: [usize; 4] = [17_582, 100_807, 19_964, 73_279];
 
@@ -65,35 +67,6 @@ pub struct NakaoChestOptions {
 struct CaseRun {
     paper: PaperCase,
     run: ChestRun,
-}
-
-/// Where and when the figures were measured.
-#[derive(Debug, Clone, Serialize)]
-pub(crate) struct Provenance {
-    /// CPU and cores.
-    pub machine: String,
-    /// When, UTC.
-    pub date_utc: String,
-    /// 1, 5 and 15 minute load averages.
-    pub load_average: String,
-}
-
-/// This machine, now, and its load.
-pub(crate) fn provenance() -> Provenance {
-    let date = std::process::Command::new("date")
-        .args(["-u", "+%Y-%m-%d %H:%M UTC"])
-        .output()
-        .ok()
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-        .unwrap_or_else(|| "unknown".into());
-    let load = std::fs::read_to_string("/proc/loadavg")
-        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|_| "unknown".into());
-    Provenance {
-        machine: crate::bench::machine(),
-        date_utc: date,
-        load_average: load,
-    }
 }
 
 fn params(case: &PaperCase) -> LocalLoopParams {

@@ -28,11 +28,40 @@ const PRESET_ORDER: [&str; 5] = [
     "rheological_fdd",
 ];
 
-/// Hold times of the rheological hold-time sweep, s.
-const HOLDS: [f64; 4] = [0.1, 0.25, 0.5, 1.0];
-
 /// Hold time of the preset comparison, s.
 const HOLD: f64 = 0.5;
+
+/// How large the runs are: the full experiment (docs/experiments/rheology/) or its quick
+/// version (`--quick`: the same parts on the coarse 10 cm block, two hold times, 2 s of
+/// sag), which shows the same behaviour in seconds instead of minutes.
+#[derive(Debug, Clone, Copy)]
+struct Scale {
+    /// The pressed block.
+    specimen: Specimen,
+    /// Hold times of the rheological hold-time sweep, s.
+    holds: &'static [f64],
+    /// Simulated seconds of the gravity sag.
+    sag_seconds: f64,
+}
+
+impl Scale {
+    /// The full experiment or the quick one.
+    fn of(quick: bool) -> Self {
+        if quick {
+            Scale {
+                specimen: Specimen::coarse(),
+                holds: &[0.1, 1.0],
+                sag_seconds: 2.0,
+            }
+        } else {
+            Scale {
+                specimen: Specimen::standard(),
+                holds: &[0.1, 0.25, 0.5, 1.0],
+                sag_seconds: 5.0,
+            }
+        }
+    }
+}
 
 /// What to run and where to write it.
 #[derive(Debug, Clone)]
@@ -41,6 +70,9 @@ pub struct RheologyOptions {
     pub out: PathBuf,
     /// The preset file, `config/rheology.ron`.
     pub presets: PathBuf,
+    /// The quick version: the coarse block, two hold times, 2 s of sag (seconds, not
+    /// minutes; the figures of docs/experiments/rheology/ are the full version's).
+    pub quick: bool,
 }
 
 /// Run every part, write CSV and PNG files into `opts.out`, and return a text summary.
@@ -48,11 +80,12 @@ pub fn run(opts: &RheologyOptions) -> Result<String> {
     std::fs::create_dir_all(&opts.out)
         .with_context(|| format!("cannot create {}", opts.out.display()))?;
     let presets = RheologyPresets::load(&opts.presets)?;
+    let scale = Scale::of(opts.quick);
     let mut summary = String::new();
     creep(&opts.out, &mut summary)?;
-    press(&opts.out, &presets, &mut summary)?;
-    hold_sweep(&opts.out, &presets, &mut summary)?;
-    gravity(&opts.out, &presets, &mut summary)?;
+    press(&opts.out, &presets, scale, &mut summary)?;
+    hold_sweep(&opts.out, &presets, scale, &mut summary)?;
+    gravity(&opts.out, &presets, scale, &mut summary)?;
     std::fs::write(opts.out.join("summary.txt"), &summary)
         .with_context(|| format!("cannot write {}", opts.out.join("summary.txt").display()))?;
     Ok(summary)
@@ -146,9 +179,9 @@ fn ordered(presets: &RheologyPresets) -> Vec<String> {
 }
 
 /// (b) The seed's press-and-release with every preset: depth curves and side views.
-fn press(out: &Path, presets: &RheologyPresets, summary: &mut String) -> Result<()> {
+fn press(out: &Path, presets: &RheologyPresets, scale: Scale, summary: &mut String) -> Result<()> {
     let names = ordered(presets);
-    let protocol = PressProtocol::standard(Specimen::standard(), HOLD);
+    let protocol = PressProtocol::standard(scale.specimen, HOLD);
     let runs: Vec<(String, PressOutcome, f64)> = names
         .par_iter()
         .map(|name| -> Result<_> {
@@ -408,12 +441,18 @@ fn side_profiles(out: &Path, runs: &[(String, PressOutcome, f64)]) -> Result<()>
 }
 
 /// (c) The rheological preset's residual against hold time.
-fn hold_sweep(out: &Path, presets: &RheologyPresets, summary: &mut String) -> Result<()> {
+fn hold_sweep(
+    out: &Path,
+    presets: &RheologyPresets,
+    scale: Scale,
+    summary: &mut String,
+) -> Result<()> {
     let material = presets.get("rheological")?;
-    let runs: Vec<(f64, PressOutcome)> = HOLDS
+    let runs: Vec<(f64, PressOutcome)> = scale
+        .holds
         .par_iter()
         .map(|&hold| -> Result<_> {
-            let protocol = PressProtocol::standard(Specimen::standard(), hold);
+            let protocol = PressProtocol::standard(scale.specimen, hold);
             Ok((hold, press_and_release(&material, &protocol)?))
         })
         .collect::<Result<_>>()?;
@@ -461,7 +500,12 @@ fn hold_sweep(out: &Path, presets: &RheologyPresets, summary: &mut String) -> Re
 }
 
 /// (d) The force-dependent damper's block and its linear twin (c2 = c_min) under gravity.
-fn gravity(out: &Path, presets: &RheologyPresets, summary: &mut String) -> Result<()> {
+fn gravity(
+    out: &Path,
+    presets: &RheologyPresets,
+    scale: Scale,
+    summary: &mut String,
+) -> Result<()> {
     let fdd = presets.get("rheological_fdd")?;
     let Damper::ForceDependent { c_min, .. } = fdd.damper else {
         anyhow::bail!(
@@ -479,7 +523,7 @@ fn gravity(out: &Path, presets: &RheologyPresets, summary: &mut String) -> Resul
     ];
     let curves: Vec<Vec<(f64, f64)>> = cases
         .par_iter()
-        .map(|(_, m)| sag_under_gravity(m, &block, 9.81, 0.5, 5.0, 100))
+        .map(|(_, m)| sag_under_gravity(m, &block, 9.81, 0.5, scale.sag_seconds, 100))
         .collect::<Result<_, _>>()?;
     let mut csv = String::from("time_s,sag_fdd_mm,sag_linear_mm\n");
     for (a, b) in curves[0].iter().zip(&curves[1]) {
@@ -512,8 +556,9 @@ fn gravity(out: &Path, presets: &RheologyPresets, summary: &mut String) -> Resul
     let (with, without) = (curves[0].last().unwrap().1, curves[1].last().unwrap().1);
     writeln!(
         summary,
-        "gravity sag over 5 s: {:.3} mm with the force-dependent damper, {:.3} mm with c2 = c_min \
+        "gravity sag over {} s: {:.3} mm with the force-dependent damper, {:.3} mm with c2 = c_min \
          ({:.1} %)",
+        scale.sag_seconds,
         1e3 * with,
         1e3 * without,
         100.0 * with / without

@@ -33,6 +33,21 @@ pub struct SceneFigure {
     pub peak_force: f64,
 }
 
+/// Scenes with more tets than this take minutes to run to their end on 2 cores (the
+/// intestine: 125 substeps a frame); tests/docs_figures.rs checks their frames and tets
+/// from the scene ([`shape`]) and leaves the full rerun to an ignored test.
+pub const LARGE_TETS: usize = 30_000;
+
+/// Frames the scene runs (its duration at its frame rate) and the tets of its mesh,
+/// without running it.
+pub fn shape(scene: &Path) -> Result<(u64, usize)> {
+    let s = crate::scene::load_scene(scene)?;
+    let built = crate::scene::build_scene(&s, scene, None)?;
+    let p = built.solver.params();
+    let frames = (s.duration / p.frame_dt).round().max(1.0) as u64;
+    Ok((frames, built.solver.mesh().tet_count()))
+}
+
 /// Run `scene` to its end on the CPU in a scratch folder and take its figures.
 pub fn measure(scene: &Path) -> Result<SceneFigure> {
     let out = std::env::temp_dir().join(format!(

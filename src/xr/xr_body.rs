@@ -303,6 +303,13 @@ mod tests {
             xr.drive_tool(Some(pose), true).unwrap();
             xr.step().unwrap();
         }
+        // A cut so far: three tets released by hand.
+        let Body::Cpu(solver) = &mut xr.body else {
+            panic!("--device cpu gave a GPU body")
+        };
+        solver.release(&[100, 2000, 5000]);
+        let cut = released_tets(xr.solver());
+        assert!(cut.len() >= 3, "{cut:?}");
         let before = xr.solver().positions().to_vec();
         let rest = xr.solver().mesh().rest_positions.clone();
         let pins = pinned_nodes(xr.solver());
@@ -318,6 +325,7 @@ mod tests {
         assert_eq!(s.params().substeps, min);
         assert_eq!(s.positions(), &before[..]);
         assert_eq!(pinned_nodes(s), pins, "pins kept");
+        assert_eq!(released_tets(s), cut, "the cut kept");
         let motion = s.tool().expect("the scalpel stays attached");
         assert_eq!(motion.to, pose);
         xr.step().unwrap();
@@ -326,5 +334,13 @@ mod tests {
         assert_eq!(xr.solver().positions(), &rest[..]);
         assert_eq!(xr.solver().params().substeps, nominal);
         assert!(!xr.tool().1);
+        assert!(released_tets(xr.solver()).is_empty(), "reset heals the cut");
+    }
+
+    /// The tets `s` has released.
+    fn released_tets(s: &Solver) -> Vec<usize> {
+        (0..s.mesh().tet_count())
+            .filter(|&i| !s.cut().is_live(i))
+            .collect()
     }
 }
