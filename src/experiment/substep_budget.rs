@@ -1,10 +1,11 @@
 //! `incise experiment substeps`: the substep budget of each XPBD scene (issue 17, item 2).
-//! Each scene runs (cutting off, so every run keeps the same tets; its grabs and its
-//! scalpel's stroke as scripted) at the fewest substeps the stability bound allows, at the
-//! scene's own count, and at a reference count (≥ 200 and ≥ 3× the scene's); the table
-//! compares the end state with the reference: the von Mises field, the displacement
-//! field, and the volume error `mean |J − 1|`. `--update FILE` rewrites the table between
-//! its markers (docs/physics-notes.md).
+//! Each scene runs as scripted (grabs, the scalpel's stroke, cutting) at the fewest
+//! substeps the stability bound allows, at the scene's own count, and at a reference count
+//! (≥ 200 and ≥ 3× the scene's); the table compares the end state with the reference: the
+//! von Mises field over the tets live in both, the displacement field, the released tets
+//! and the volume error `mean |J − 1|`. A run the solver stops (an inverted tet) is a row
+//! that says so. `--update FILE` rewrites the table between its markers
+//! (docs/physics-notes.md).
 
 use std::path::{Path, PathBuf};
 
@@ -25,9 +26,11 @@ pub const END: &str = "<!-- /substep-budget -->";
 pub const CONVERGED: f64 = 0.05;
 
 /// The end state of one run.
+#[derive(Clone)]
 struct EndState {
     x: Vec<Vec3>,
     von_mises: Vec<f32>,
+    live: Vec<bool>,
     volume_error: f64,
     ms_per_frame: f64,
 }
@@ -41,27 +44,32 @@ pub struct BudgetRow {
     pub substeps: u32,
     /// What this count is: "bound", "scene", "bound = scene" or "reference".
     pub role: &'static str,
-    /// `‖σ_vM − σ_vM,ref‖ / ‖σ_vM,ref‖` over the tets.
+    /// `‖σ_vM − σ_vM,ref‖ / ‖σ_vM,ref‖` over the tets live in both runs.
     pub stress_error: f64,
-    /// `max |x − x_ref| / max |x_ref − X|` over the nodes.
+    /// `‖x − x_ref‖ / ‖x_ref − X‖` over the nodes.
     pub displacement_error: f64,
-    /// `mean |J − 1|` over the tets.
+    /// Released tets at the end.
+    pub released: usize,
+    /// `mean |J − 1|` over the live tets.
     pub volume_error: f64,
     /// Wall ms per frame of this run (machine-dependent).
     pub ms_per_frame: f64,
+    /// Why the run stopped early, if it did (the errors are then NaN).
+    pub failure: Option<String>,
 }
 
 impl BudgetRow {
     /// Whether both field errors are within [`CONVERGED`].
     pub fn converged(&self) -> bool {
-        self.stress_error <= CONVERGED && self.displacement_error <= CONVERGED
+        self.failure.is_none()
+            && self.stress_error <= CONVERGED
+            && self.displacement_error <= CONVERGED
     }
 }
 
-/// Run `scene` for `frames` frames at `substeps` with cutting off.
+/// Run `scene` for `frames` frames at `substeps`.
 fn run_at(scene_path: &Path, substeps: u32, frames: u32) -> Result<EndState> {
     let mut scene = load_scene(scene_path)?;
-    scene.cutting = None;
     scene.solver.substeps = substeps;
     let built = build_scene(&scene, scene_path, None)
         .with_context(|| format!("{}: {substeps} substeps", scene_path.display()))?;
@@ -82,21 +90,28 @@ fn run_at(scene_path: &Path, substeps: u32, frames: u32) -> Result<EndState> {
 }
 
 fn end_state(s: &Solver, ms_per_frame: f64) -> EndState {
-    let j = s.det_f();
-    let volume_error = j.iter().map(|&j| (j as f64 - 1.0).abs()).sum::<f64>() / j.len() as f64;
+    let live: Vec<bool> = (0..s.mesh().tet_count())
+        .map(|t| s.cut().is_live(t))
+        .collect();
+    let j: Vec<f64> = s
+        .det_f()
+        .iter()
+        .zip(&live)
+        .filter(|(_, l)| **l)
+        .map(|(&j, _)| (j as f64 - 1.0).abs())
+        .collect();
     EndState {
         x: s.positions().to_vec(),
         von_mises: s.von_mises().to_vec(),
-        volume_error,
+        volume_error: j.iter().sum::<f64>() / j.len().max(1) as f64,
+        live,
         ms_per_frame,
     }
 }
 
-/// Relative L2 error of `a` against `b`.
-fn field_error(a: &[f32], b: &[f32]) -> f64 {
-    let (num, den) = a.iter().zip(b).fold((0.0f64, 0.0f64), |(n, d), (&a, &b)| {
-        (n + ((a - b) as f64).powi(2), d + (b as f64).powi(2))
-    });
+/// `sqrt(Σ err² / Σ ref²)` over pairs of (error, reference) magnitudes.
+fn relative_l2(pairs: impl Iterator<Item = (f64, f64)>) -> f64 {
+    let (num, den) = pairs.fold((0.0, 0.0), |(n, d), (e, r)| (n + e * e, d + r * r));
     if den == 0.0 {
         num.sqrt()
     } else {
@@ -104,13 +119,56 @@ fn field_error(a: &[f32], b: &[f32]) -> f64 {
     }
 }
 
-/// Largest node distance from the reference, relative to the reference's largest
-/// displacement from rest.
+/// The von Mises field's relative L2 error over the tets live in both runs.
+fn stress_error(st: &EndState, reference: &EndState) -> f64 {
+    let both = (0..st.live.len()).filter(|&t| st.live[t] && reference.live[t]);
+    relative_l2(both.map(|t| {
+        let (a, b) = (st.von_mises[t] as f64, reference.von_mises[t] as f64);
+        (a - b, b)
+    }))
+}
+
+/// The displacement field's relative L2 error: `‖x − x_ref‖ / ‖x_ref − X‖`.
 fn displacement_error(x: &[Vec3], reference: &[Vec3], rest: &[Vec3]) -> f64 {
-    let max = |f: &dyn Fn(usize) -> f32| (0..x.len()).map(f).fold(0.0f32, f32::max) as f64;
-    let moved = max(&|i| (reference[i] - rest[i]).length());
-    let off = max(&|i| (x[i] - reference[i]).length());
-    if moved == 0.0 { off } else { off / moved }
+    relative_l2((0..x.len()).map(|i| {
+        let e = (x[i] - reference[i]).length() as f64;
+        (e, (reference[i] - rest[i]).length() as f64)
+    }))
+}
+
+/// The row of one run (`Err`: the run stopped).
+fn row(
+    scene: &Path,
+    (substeps, role): (u32, &'static str),
+    run: Result<EndState>,
+    reference: &EndState,
+    rest: &[Vec3],
+) -> BudgetRow {
+    let base = BudgetRow {
+        scene: scene.display().to_string(),
+        substeps,
+        role,
+        stress_error: f64::NAN,
+        displacement_error: f64::NAN,
+        released: 0,
+        volume_error: f64::NAN,
+        ms_per_frame: f64::NAN,
+        failure: None,
+    };
+    match run {
+        Ok(st) => BudgetRow {
+            stress_error: stress_error(&st, reference),
+            displacement_error: displacement_error(&st.x, &reference.x, rest),
+            released: st.live.iter().filter(|l| !**l).count(),
+            volume_error: st.volume_error,
+            ms_per_frame: st.ms_per_frame,
+            ..base
+        },
+        Err(e) => BudgetRow {
+            failure: Some(format!("{e:#}").replace('|', "/")),
+            ..base
+        },
+    }
 }
 
 /// The fewest substeps the stability bound allows for `scene` (κ ≤ 1 at the worst tet).
@@ -136,7 +194,8 @@ fn bound_substeps(scene_path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
 pub fn measure(scene_path: &Path, frames: u32) -> Result<Vec<BudgetRow>> {
     let (bound, own, rest) = bound_substeps(scene_path)?;
     let reference = 200.max(3 * own);
-    let ref_state = run_at(scene_path, reference, frames)?;
+    let ref_state = run_at(scene_path, reference, frames)
+        .with_context(|| format!("{}: the reference run", scene_path.display()))?;
     let mut counts = vec![(
         bound,
         if bound == own {
@@ -148,54 +207,63 @@ pub fn measure(scene_path: &Path, frames: u32) -> Result<Vec<BudgetRow>> {
     if own != bound {
         counts.push((own, "scene"));
     }
-    counts.push((reference, "reference"));
-    counts
+    let mut rows: Vec<BudgetRow> = counts
         .into_iter()
-        .map(|(n, role)| {
-            let st = if n == reference {
-                EndState {
-                    x: ref_state.x.clone(),
-                    von_mises: ref_state.von_mises.clone(),
-                    ..ref_state
-                }
-            } else {
-                run_at(scene_path, n, frames)?
-            };
-            Ok(BudgetRow {
-                scene: scene_path.display().to_string(),
-                substeps: n,
-                role,
-                stress_error: field_error(&st.von_mises, &ref_state.von_mises),
-                displacement_error: displacement_error(&st.x, &ref_state.x, &rest),
-                volume_error: st.volume_error,
-                ms_per_frame: st.ms_per_frame,
-            })
+        .map(|c| {
+            row(
+                scene_path,
+                c,
+                run_at(scene_path, c.0, frames),
+                &ref_state,
+                &rest,
+            )
         })
-        .collect()
+        .collect();
+    let own_ref = Ok(ref_state.clone());
+    rows.push(row(
+        scene_path,
+        (reference, "reference"),
+        own_ref,
+        &ref_state,
+        &rest,
+    ));
+    Ok(rows)
 }
 
 /// The rows as a markdown table (between [`BEGIN`] and [`END`]).
 pub fn markdown(rows: &[BudgetRow], frames: u32) -> String {
     let mut s = format!(
-        "{BEGIN}\n\n{frames} frames per run, cutting off. Errors against the reference run; converged: both ≤ {:.0} %.\n\n\
-         | scene | substeps | which | σvM field error | displacement error | mean \\|J − 1\\| | converged | ms/frame |\n\
-         |---|---:|---|---:|---:|---:|---|---:|\n",
+        "{BEGIN}\n\n{frames} frames per run, as scripted (cutting on). Errors against the \
+         reference run (stress over the tets live in both); converged: both ≤ {:.0} %.\n\n\
+         | scene | substeps | which | σvM field error | displacement error | released tets | mean \\|J − 1\\| | converged | ms/frame |\n\
+         |---|---:|---|---:|---:|---:|---:|---|---:|\n",
         CONVERGED * 100.0
     );
     for r in rows {
-        s += &format!(
-            "| {} | {} | {} | {:.2} % | {:.2} % | {:.2e} | {} | {:.1} |\n",
-            r.scene,
-            r.substeps,
-            r.role,
-            r.stress_error * 100.0,
-            r.displacement_error * 100.0,
-            r.volume_error,
-            if r.converged() { "yes" } else { "no" },
-            r.ms_per_frame
-        );
+        s += &table_row(r);
     }
     s + "\n" + END + "\n"
+}
+
+fn table_row(r: &BudgetRow) -> String {
+    if let Some(why) = &r.failure {
+        return format!(
+            "| {} | {} | {} | – | – | – | – | no: {why} | – |\n",
+            r.scene, r.substeps, r.role
+        );
+    }
+    format!(
+        "| {} | {} | {} | {:.2} % | {:.2} % | {} | {:.2e} | {} | {:.1} |\n",
+        r.scene,
+        r.substeps,
+        r.role,
+        r.stress_error * 100.0,
+        r.displacement_error * 100.0,
+        r.released,
+        r.volume_error,
+        if r.converged() { "yes" } else { "no" },
+        r.ms_per_frame
+    )
 }
 
 /// Measure `scenes` and print (or, with `update_file`, also rewrite) the table.
