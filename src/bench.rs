@@ -82,6 +82,17 @@ pub enum BenchOutput {
     Markdown,
 }
 
+impl BenchOutput {
+    /// The form the `--json` and `--markdown` flags ask for.
+    pub fn of(json: bool, markdown: bool) -> Self {
+        match (json, markdown) {
+            (true, _) => BenchOutput::Json,
+            (_, true) => BenchOutput::Markdown,
+            _ => BenchOutput::Table,
+        }
+    }
+}
+
 /// Run the benchmark and print its results in `output`'s form.
 pub fn run(
     case: BenchCase,

@@ -49,36 +49,97 @@ pub struct RealtimeResult {
 /// CPU threads (default: the scene's) and projection kernel (default: the scene's).
 pub type CpuChoice = (Option<usize>, Option<CpuKernel>);
 
-/// Time `frames` frames of `scene` on `device` and print a table row or the JSON.
+/// Interleaved runs per kernel of the `--markdown` table.
+pub const MARKDOWN_RUNS: usize = 3;
+
+/// Time `frames` frames of `scene` on `device` and print a table row, the JSON, or (with
+/// `Markdown`) both CPU kernels interleaved, [`MARKDOWN_RUNS`] runs each, as the
+/// markdown table of docs/performance.md under its provenance line.
 pub fn run(
     scene: &Path,
     device: DeviceChoice,
     cpu: CpuChoice,
     frames: u32,
-    json: bool,
+    output: crate::bench::BenchOutput,
 ) -> Result<()> {
+    use crate::bench::BenchOutput;
+    if output == BenchOutput::Markdown {
+        let kernels = match cpu.1 {
+            Some(k) => vec![k],
+            None => vec![CpuKernel::Scalar, CpuKernel::Lanes],
+        };
+        let mut runs: Vec<Vec<RealtimeResult>> = vec![Vec::new(); kernels.len()];
+        for _ in 0..MARKDOWN_RUNS {
+            for (k, kernel) in kernels.iter().enumerate() {
+                runs[k].push(measure(scene, device, (cpu.0, Some(*kernel)), frames)?);
+            }
+        }
+        print!("{}", markdown(&runs));
+        return Ok(());
+    }
     let r = measure(scene, device, cpu, frames)?;
-    if json {
+    if output == BenchOutput::Json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
-        println!(
-            "{} on {} ({} kernel): {} tets, {} substeps/frame: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
-             substeps {:.1} ms, release checks {:.1} ms, stress+guards {:.1} ms{}",
-            r.scene,
-            r.device,
-            r.cpu_kernel,
-            r.tets,
-            r.substeps,
-            r.frame_ms_median,
-            r.frame_ms_p99,
-            r.frames_per_second,
-            r.substeps_ms_median,
-            r.release_checks_ms_median,
-            r.stress_ms_median,
-            if r.real_time { " (real time)" } else { "" }
-        );
+        println!("{}", summary(&r));
     }
     Ok(())
+}
+
+/// One result as a line of text.
+fn summary(r: &RealtimeResult) -> String {
+    format!(
+        "{} on {} ({} kernel): {} tets, {} substeps/frame: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
+         substeps {:.1} ms, release checks {:.1} ms, stress+guards {:.1} ms{}",
+        r.scene,
+        r.device,
+        r.cpu_kernel,
+        r.tets,
+        r.substeps,
+        r.frame_ms_median,
+        r.frame_ms_p99,
+        r.frames_per_second,
+        r.substeps_ms_median,
+        r.release_checks_ms_median,
+        r.stress_ms_median,
+        if r.real_time { " (real time)" } else { "" }
+    )
+}
+
+/// The runs of each kernel (one inner list per kernel) as docs/performance.md's
+/// realtime table: min and median over the runs of each run's median frame.
+pub fn markdown(runs: &[Vec<RealtimeResult>]) -> String {
+    let mut s = format!(
+        "{}\n\n| scene | device | tets | substeps / frame | kernel | ms/frame min / median | fps (median) | ms per substep | release checks ms | stress + guards ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+        crate::provenance::generated_by()
+    );
+    for rs in runs.iter().filter(|rs| !rs.is_empty()) {
+        let mut frame: Vec<f64> = rs.iter().map(|r| r.frame_ms_median).collect();
+        frame.sort_by(f64::total_cmp);
+        let median = percentile(&frame, 0.5);
+        let mid = |f: &dyn Fn(&RealtimeResult) -> f64| {
+            let mut v: Vec<f64> = rs.iter().map(f).collect();
+            v.sort_by(f64::total_cmp);
+            percentile(&v, 0.5)
+        };
+        let r = &rs[0];
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} | {:.2} | {:.1} | {:.2} |\n",
+            r.scene,
+            r.device,
+            r.tets,
+            r.substeps,
+            r.cpu_kernel,
+            frame[0],
+            median,
+            1e3 / median,
+            mid(&|r| r.substeps_ms_median) / r.substeps as f64,
+            mid(&|r| r.release_checks_ms_median),
+            mid(&|r| r.stress_ms_median),
+        );
+    }
+    s
 }
 
 /// The measurement behind [`run`].

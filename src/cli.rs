@@ -191,9 +191,9 @@ pub enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Solver target: print the table as the markdown rows of docs/performance.md,
-        /// under a line giving the command, machine (CPU model, cores), UTC date and load
-        /// average.
+        /// Print the table as the markdown rows of docs/performance.md, under a line giving
+        /// the command, machine (CPU model, cores), UTC date and load average (`realtime`:
+        /// both CPU kernels interleaved, three runs each, unless `--cpu-kernel` names one).
         #[arg(long, conflicts_with = "json")]
         markdown: bool,
         /// Frames to time per case (after 2 warm-up frames; the solver target interleaves

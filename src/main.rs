@@ -182,13 +182,14 @@ fn main() -> ExitCode {
             scene,
             threads,
             cpu_kernel,
+            markdown,
             ..
         } => bench_realtime::run(
             &scene,
             device,
             (threads, cpu_kernel.map(Into::into)),
             frames,
-            json,
+            bench::BenchOutput::of(json, markdown),
         ),
         Command::Bench {
             target: BenchTarget::Solver,
@@ -200,12 +201,13 @@ fn main() -> ExitCode {
             markdown,
             ..
         } => {
-            let output = match (json, markdown) {
-                (true, _) => bench::BenchOutput::Json,
-                (_, true) => bench::BenchOutput::Markdown,
-                _ => bench::BenchOutput::Table,
-            };
-            bench::run(case, frames, output, device, scaling)
+            bench::run(
+                case,
+                frames,
+                bench::BenchOutput::of(json, markdown),
+                device,
+                scaling,
+            )
         }
         Command::Soak {
             scene,

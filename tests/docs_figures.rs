@@ -110,7 +110,13 @@ fn has_provenance(line: &str) -> bool {
 #[test]
 fn timed_tables_say_which_command_machine_date_and_load() {
     for (name, commands) in [
-        ("docs/performance.md", &["incise bench --markdown"][..]),
+        (
+            "docs/performance.md",
+            &[
+                "incise bench --markdown",
+                "incise bench realtime --markdown",
+            ][..],
+        ),
         (
             "docs/reliability.md",
             &["incise soak config/plate_cut.ron"][..],
