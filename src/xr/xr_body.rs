@@ -226,7 +226,7 @@ impl XrBody {
     }
 
     /// Run `substeps` per frame from now on: the solver is rebuilt with the same state
-    /// (positions, released tets, pins, tool; velocities restart from rest).
+    /// (positions, velocities, released tets, pins, tool).
     pub fn set_substeps(&mut self, substeps: u32) -> Result<()> {
         let old = self.body.solver();
         if substeps == old.params().substeps {
@@ -243,6 +243,7 @@ impl XrBody {
             .collect();
         s.release(&released);
         s.pin(&pinned_nodes(old));
+        s.set_velocities(old.velocities());
         s.set_tool(self.contact(), self.pose)?;
         self.body = place_on(s, self.device, &self.dev)?;
         Ok(())
@@ -311,6 +312,11 @@ mod tests {
         let cut = released_tets(xr.solver());
         assert!(cut.len() >= 3, "{cut:?}");
         let before = xr.solver().positions().to_vec();
+        let moving = xr.solver().velocities().to_vec();
+        assert!(
+            moving.iter().any(|v| v.length() > 1e-5),
+            "the plate is sagging"
+        );
         let rest = xr.solver().mesh().rest_positions.clone();
         let pins = pinned_nodes(xr.solver());
         assert!(!pins.is_empty());
@@ -324,6 +330,7 @@ mod tests {
         let s = xr.solver();
         assert_eq!(s.params().substeps, min);
         assert_eq!(s.positions(), &before[..]);
+        assert_eq!(s.velocities(), &moving[..], "the motion goes on");
         assert_eq!(pinned_nodes(s), pins, "pins kept");
         assert_eq!(released_tets(s), cut, "the cut kept");
         let motion = s.tool().expect("the scalpel stays attached");

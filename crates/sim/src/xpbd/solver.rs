@@ -261,6 +261,17 @@ impl Solver {
         &self.v
     }
 
+    /// Replace the free nodes' velocities, m/s (to carry a moving state into a rebuilt
+    /// solver, after [`Solver::set_positions`] zeroed them); pinned, grabbed and retired
+    /// nodes keep theirs.
+    pub fn set_velocities(&mut self, v: &[Vec3]) {
+        for ((dst, src), kind) in self.v.iter_mut().zip(v).zip(&self.kind) {
+            if *kind == NodeKind::Free {
+                *dst = *src;
+            }
+        }
+    }
+
     /// Lumped node masses, kg.
     pub fn masses(&self) -> &[f32] {
         &self.mass
