@@ -10,6 +10,7 @@ pub mod obj;
 pub mod pvd;
 pub mod tetgen;
 pub mod text;
+pub mod vtk_cells;
 pub mod vtk_legacy;
 pub mod vtu;
 mod xml;

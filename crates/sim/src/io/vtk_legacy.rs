@@ -6,7 +6,6 @@
 //! types are skipped with one warning per type. `FIELD` data is skipped, and everything from
 //! `POINT_DATA`/`CELL_DATA` on is ignored.
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -14,21 +13,8 @@ use glam::Vec3;
 
 use super::atomic::write_atomic;
 use super::text::{Cursor, Fields, capacity, quote};
+use super::vtk_cells::{CellList, VTK_TETRA, tets_from_cells};
 use crate::{MeshError, RawMesh};
-
-/// VTK cell type of a linear tetrahedron.
-pub const VTK_TETRA: u32 = 10;
-/// VTK cell type of a quadratic (10-node) tetrahedron; its first four points are corners.
-pub const VTK_QUADRATIC_TETRA: u32 = 24;
-
-/// Cells as read: connectivity, and per cell its run in it and the line it starts on.
-#[derive(Debug, Default)]
-pub(super) struct CellList {
-    /// Point indices of all cells, concatenated.
-    pub conn: Vec<u32>,
-    /// Per cell: (start in `conn`, number of points, 1-based line where it starts).
-    pub runs: Vec<(usize, usize, usize)>,
-}
 
 /// Parse a legacy VTK ASCII unstructured grid; `origin` names it in errors.
 pub fn parse_vtk(text: &str, origin: &Path) -> Result<RawMesh, MeshError> {
@@ -135,72 +121,6 @@ pub fn write_vtk(path: &Path, positions: &[Vec3], tets: &[[u32; 4]]) -> Result<(
         let _ = writeln!(s, "{VTK_TETRA}");
     }
     write_atomic(path, s.as_bytes())
-}
-
-/// Human name of a VTK cell type.
-pub fn cell_type_name(ty: u32) -> Option<&'static str> {
-    Some(match ty {
-        1 => "vertex",
-        2 => "poly-vertex",
-        3 => "line",
-        4 => "poly-line",
-        5 => "triangle",
-        6 => "triangle strip",
-        7 => "polygon",
-        8 => "pixel",
-        9 => "quad",
-        10 => "tetra",
-        11 => "voxel",
-        12 => "hexahedron",
-        13 => "wedge",
-        14 => "pyramid",
-        21 => "quadratic edge",
-        22 => "quadratic triangle",
-        23 => "quadratic quad",
-        24 => "quadratic tetra",
-        25 => "quadratic hexahedron",
-        _ => return None,
-    })
-}
-
-/// Tets from cells and their types; other types become one warning per type.
-pub(super) fn tets_from_cells(
-    cells: &CellList,
-    types: &[u32],
-    origin: &Path,
-) -> Result<(Vec<[u32; 4]>, Vec<String>), MeshError> {
-    let mut tets = Vec::with_capacity(cells.runs.len());
-    let mut skipped: BTreeMap<u32, u64> = BTreeMap::new();
-    for (k, (&(start, len, line), &ty)) in cells.runs.iter().zip(types).enumerate() {
-        let need = match ty {
-            VTK_TETRA => 4,
-            VTK_QUADRATIC_TETRA => 10,
-            _ => {
-                *skipped.entry(ty).or_default() += 1;
-                continue;
-            }
-        };
-        if len != need {
-            return Err(MeshError::parse(
-                origin,
-                line,
-                format!("cell {k} has type {ty} ({need} points) but lists {len} points"),
-            ));
-        }
-        let c = &cells.conn[start..start + 4];
-        tets.push([c[0], c[1], c[2], c[3]]);
-    }
-    let warnings = skipped
-        .into_iter()
-        .map(|(ty, n)| {
-            let noun = if n == 1 { "cell" } else { "cells" };
-            match cell_type_name(ty) {
-                Some(name) => format!("skipped {n} {noun} of VTK type {ty} ({name})"),
-                None => format!("skipped {n} {noun} of VTK type {ty}"),
-            }
-        })
-        .collect();
-    Ok((tets, warnings))
 }
 
 /// The header line, the title line and `ASCII`.

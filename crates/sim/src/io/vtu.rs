@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use super::atomic::write_atomic;
 use super::text::{Cursor, capacity, quote};
-use super::vtk_legacy::{CellList, VTK_TETRA, tets_from_cells};
+use super::vtk_cells::{CellList, VTK_TETRA, tets_from_cells};
 use super::xml::{Scanner, Tag, TagKind, escape_attr};
 use crate::{MeshError, RawMesh};
 
