@@ -306,6 +306,9 @@ fn skip_field(c: &mut Cursor<'_>, line: &mut Fields<'_>) -> Result<(), MeshError
 
 #[cfg(test)]
 mod tests {
+    use super::super::format_checks::{
+        assert_errors, assert_read_back, assert_two_tets_and_a_triangle, scratch,
+    };
     use super::*;
 
     const TWO_TETS: &str = "\
@@ -361,22 +364,9 @@ CELL_TYPES 3
         parse_vtk(text, Path::new("m.vtk"))
     }
 
-    fn err_text(text: &str) -> String {
-        vtk(text).expect_err("input is malformed").to_string()
-    }
-
     #[test]
     fn classic_layout_with_field_data_and_skipped_triangle() {
-        let raw = vtk(TWO_TETS).expect("valid");
-        assert_eq!(
-            raw.positions,
-            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE]
-        );
-        assert_eq!(raw.tets, vec![[0, 1, 2, 3], [1, 2, 3, 4]]);
-        assert_eq!(
-            raw.warnings,
-            vec!["skipped 1 cell of VTK type 5 (triangle)"]
-        );
+        assert_two_tets_and_a_triangle(&vtk(TWO_TETS).expect("valid"));
     }
 
     #[test]
@@ -395,94 +385,90 @@ CELL_TYPES 3
 
     #[test]
     fn out_of_range_point_names_the_cell_line() {
-        let msg = err_text(&TWO_TETS.replace("4 1 2 3 4", "4 1 2 3 5"));
-        assert!(
-            msg.contains("m.vtk:15: cell 2 references point 5, but POINTS has 5"),
-            "{msg}"
-        );
-        let msg = err_text(&VTK51.replace("0 1 2\n4", "0 1 2\n7"));
-        assert!(msg.contains("m.vtk:17: cell 2 references point 7"), "{msg}");
+        let cases = [
+            (
+                TWO_TETS.replace("4 1 2 3 4", "4 1 2 3 5"),
+                "m.vtk:15: cell 2 references point 5, but POINTS has 5",
+            ),
+            (
+                VTK51.replace("0 1 2\n4", "0 1 2\n7"),
+                "m.vtk:17: cell 2 references point 7",
+            ),
+        ];
+        assert_errors(vtk, &cases);
     }
 
     #[test]
     fn wrong_counts_are_errors_with_lines() {
-        let msg = err_text(&TWO_TETS.replace("1 1 1\nCELLS", "CELLS"));
-        assert!(
-            msg.contains("m.vtk:11: expected a coordinate of point 5 of 5, found \"CELLS\""),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("POINTS 5", "POINTS 4"));
-        assert!(
-            msg.contains("m.vtk:11: expected a keyword such as CELLS"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("CELLS 3 14", "CELLS 3 15"));
-        assert!(
-            msg.contains("m.vtk:12: CELLS announces a list of 15 numbers"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("CELL_TYPES 3", "CELL_TYPES 2"));
-        assert!(
-            msg.contains("m.vtk:16: CELL_TYPES announces 2 cells, but CELLS has 3"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("3 0 1 2", "4 0 1 2"));
-        assert!(
-            msg.contains("m.vtk:15: found \"3\" after the 3 cells announced"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("10 5", "10 10"));
-        assert!(
-            msg.contains("m.vtk:14: cell 1 has type 10 (4 points) but lists 3"),
-            "{msg}"
-        );
-        let msg = err_text(&VTK51.replace("0 4 7 8", "0 4 3 8"));
-        assert!(
-            msg.contains("m.vtk:13: offset 3 must start at 0, not decrease"),
-            "{msg}"
-        );
+        let cases = [
+            (
+                TWO_TETS.replace("1 1 1\nCELLS", "CELLS"),
+                "m.vtk:11: expected a coordinate of point 5 of 5, found \"CELLS\"",
+            ),
+            (
+                TWO_TETS.replace("POINTS 5", "POINTS 4"),
+                "m.vtk:11: expected a keyword such as CELLS",
+            ),
+            (
+                TWO_TETS.replace("CELLS 3 14", "CELLS 3 15"),
+                "m.vtk:12: CELLS announces a list of 15 numbers",
+            ),
+            (
+                TWO_TETS.replace("CELL_TYPES 3", "CELL_TYPES 2"),
+                "m.vtk:16: CELL_TYPES announces 2 cells, but CELLS has 3",
+            ),
+            (
+                TWO_TETS.replace("3 0 1 2", "4 0 1 2"),
+                "m.vtk:15: found \"3\" after the 3 cells announced",
+            ),
+            (
+                TWO_TETS.replace("10 5", "10 10"),
+                "m.vtk:14: cell 1 has type 10 (4 points) but lists 3",
+            ),
+            (
+                VTK51.replace("0 4 7 8", "0 4 3 8"),
+                "m.vtk:13: offset 3 must start at 0, not decrease",
+            ),
+        ];
+        assert_errors(vtk, &cases);
     }
 
     #[test]
     fn truncated_non_numeric_and_empty_inputs_are_errors() {
-        let cut = TWO_TETS.find("CELL_TYPES").unwrap_or(0);
-        let msg = err_text(&TWO_TETS[..cut]);
-        assert!(
-            msg.contains("m.vtk:15: unexpected end of file: expected a CELL_TYPES"),
-            "{msg}"
-        );
-        let cut = TWO_TETS.find("4 1 2 3 4").unwrap_or(0);
-        let msg = err_text(&TWO_TETS[..cut]);
-        assert!(
-            msg.contains("m.vtk:14: unexpected end of file: expected the point count"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("0 0 1\n", "0 O 1\n"));
-        assert!(
-            msg.contains("m.vtk:10: expected a coordinate of point 4 of 5, found \"O\""),
-            "{msg}"
-        );
-        let msg = err_text("");
-        assert!(msg.contains("m.vtk:0: the file is empty"), "{msg}");
-        let msg = err_text("# vtk DataFile Version 3.0\nt\nBINARY\n");
-        assert!(
-            msg.contains("m.vtk:3: binary .vtk is not supported"),
-            "{msg}"
-        );
-        let msg = err_text("# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\n");
-        assert!(
-            msg.contains("m.vtk:4: only DATASET UNSTRUCTURED_GRID is supported"),
-            "{msg}"
-        );
-        let msg = err_text("ply\nformat ascii 1.0\n");
-        assert!(msg.contains("m.vtk:1: expected the header"), "{msg}");
+        let before = |marker: &str| TWO_TETS[..TWO_TETS.find(marker).unwrap_or(0)].to_string();
+        let cases = [
+            (
+                before("CELL_TYPES"),
+                "m.vtk:15: unexpected end of file: expected a CELL_TYPES",
+            ),
+            (
+                before("4 1 2 3 4"),
+                "m.vtk:14: unexpected end of file: expected the point count",
+            ),
+            (
+                TWO_TETS.replace("0 0 1\n", "0 O 1\n"),
+                "m.vtk:10: expected a coordinate of point 4 of 5, found \"O\"",
+            ),
+            (String::new(), "m.vtk:0: the file is empty"),
+            (
+                "# vtk DataFile Version 3.0\nt\nBINARY\n".into(),
+                "m.vtk:3: binary .vtk is not supported",
+            ),
+            (
+                "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\n".into(),
+                "m.vtk:4: only DATASET UNSTRUCTURED_GRID is supported",
+            ),
+            (
+                "ply\nformat ascii 1.0\n".into(),
+                "m.vtk:1: expected the header",
+            ),
+        ];
+        assert_errors(vtk, &cases);
     }
 
     #[test]
     fn write_then_parse_round_trips() {
-        let dir = std::env::temp_dir().join(format!("incise-io-vtk-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let dir = scratch("vtk");
         let positions: Vec<Vec3> = (0..7)
             .map(|i| {
                 Vec3::new(
@@ -496,12 +482,7 @@ CELL_TYPES 3
         let path = dir.join("mesh.vtk");
         write_vtk(&path, &positions, &tets).expect("write");
         let raw = super::super::load_mesh(&path).expect("read back");
-        assert_eq!(raw.positions.len(), positions.len());
-        for (a, b) in raw.positions.iter().zip(&positions) {
-            assert!((*a - *b).abs().max_element() <= 1e-6 * b.abs().max_element().max(1.0));
-        }
-        assert_eq!(raw.tets, tets);
-        assert!(raw.warnings.is_empty());
+        assert_read_back(&raw, &positions, &tets);
         let _ = std::fs::remove_dir_all(&dir);
     }
 
