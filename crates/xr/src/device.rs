@@ -91,16 +91,7 @@ impl RenderDevice {
     /// The same device as a [`GpuContext`] for the GPU solver (device loss and uncaptured
     /// errors are routed to the context's fault record from here on).
     pub fn compute_context(&self) -> GpuContext {
-        let fault = incise_sim::gpu::DeviceFault::default();
-        fault.watch(&self.device);
-        GpuContext {
-            fault,
-            device: self.device.clone(),
-            queue: self.queue.clone(),
-            info: self.info.clone(),
-            timestamps: self.timestamps,
-            max_binding: self.limits.max_storage_buffer_binding_size,
-        }
+        GpuContext::on(&self.0)
     }
 
     /// "name (backend, device type)" for reports.

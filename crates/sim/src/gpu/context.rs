@@ -1,6 +1,6 @@
 //! Opening a wgpu device for compute: any adapter (a discrete GPU, or Mesa lavapipe in CI).
 
-use super::device::{DeviceRequest, OpenError, describe_adapter, open_device};
+use super::device::{DeviceRequest, OpenError, OpenedDevice, describe_adapter, open_device};
 
 /// The compute solver's own device.
 const COMPUTE: DeviceRequest = DeviceRequest {
@@ -111,16 +111,22 @@ impl GpuContext {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let opened = open_device(&instance, None, &COMPUTE).await?;
+        Ok(Self::on(&opened))
+    }
+
+    /// A context on `opened`'s device and queue (the same ones: wgpu handles are shared,
+    /// not copied), whose loss and uncaptured errors go to the new fault record from now on.
+    pub fn on(opened: &OpenedDevice) -> Self {
         let fault = DeviceFault::default();
         fault.watch(&opened.device);
-        Ok(GpuContext {
+        GpuContext {
             fault,
-            device: opened.device,
-            queue: opened.queue,
-            max_binding: opened.limits.max_storage_buffer_binding_size,
-            info: opened.info,
+            device: opened.device.clone(),
+            queue: opened.queue.clone(),
+            info: opened.info.clone(),
             timestamps: opened.timestamps,
-        })
+            max_binding: opened.limits.max_storage_buffer_binding_size,
+        }
     }
 
     /// "name (backend, device type)" for reports.
