@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use incise_sim::TetMesh;
+use incise_sim::ron_file;
 
 use super::model::Exercise;
 use super::plan::{Plan, RestSurface};
@@ -29,10 +30,7 @@ pub struct LoadedExercise {
 /// Read, validate and place an exercise: its fields, its scene (which must have a
 /// scalpel) and its plan (every point within `surface_tolerance` of the organ's surface).
 pub fn load_exercise(path: &Path) -> Result<LoadedExercise> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.into(),
-        source,
-    })?;
+    let text = ron_file::read(path).map_err(SceneError::from)?;
     let exercise = parse_exercise(&text, path)?;
     let value_err = |field: &str, line: usize, msg: String| SceneError::Value {
         path: path.into(),
@@ -93,12 +91,7 @@ pub fn load_exercise(path: &Path) -> Result<LoadedExercise> {
 
 /// Parse exercise text and check every value's range; `path` names it in errors.
 pub fn parse_exercise(text: &str, path: &Path) -> Result<Exercise, SceneError> {
-    let ex: Exercise = ron::from_str(text).map_err(|e| SceneError::Syntax {
-        path: path.into(),
-        line: e.span.start.line,
-        col: e.span.start.col,
-        msg: e.code.to_string(),
-    })?;
+    let ex: Exercise = ron_file::parse(text, path)?;
     let err = |field: &str, msg: String| SceneError::Value {
         path: path.into(),
         line: field_line(text, field),

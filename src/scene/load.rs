@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use incise_sim::Material;
+use incise_sim::ron_file::{self, ReadError, SyntaxError};
 
 use super::{MaterialChoice, Scene};
 
@@ -11,25 +12,11 @@ use super::{MaterialChoice, Scene};
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// OS error.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] ReadError),
     /// RON syntax, unknown field, wrong type: ron's position and message.
-    #[error("{path}:{line}:{col}: {msg}")]
-    Syntax {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        col: usize,
-        /// ron's message (names the field).
-        msg: String,
-    },
+    #[error(transparent)]
+    Syntax(#[from] SyntaxError),
     /// A value parsed but is out of range.
     #[error("{path}:{line}: {field} {msg}")]
     Value {
@@ -46,16 +33,13 @@ pub enum SceneError {
 
 /// Read and validate a scene file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.into(),
-        source,
-    })?;
+    let text = ron_file::read(path)?;
     parse_scene(&text, path)
 }
 
 /// Parse and validate scene text; `path` names it in errors.
 pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
-    let scene: Scene = ron::from_str(text).map_err(|e| syntax(path, e))?;
+    let scene: Scene = ron_file::parse(text, path)?;
     let value_err = |field: &str, msg: String| SceneError::Value {
         path: path.into(),
         line: locate(text, field),
@@ -142,11 +126,8 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
 
 /// Read `materials.ron`: a map from preset name to material, each validated.
 pub fn load_materials(path: &Path) -> Result<BTreeMap<String, Material>, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.into(),
-        source,
-    })?;
-    let map: BTreeMap<String, Material> = ron::from_str(&text).map_err(|e| syntax(path, e))?;
+    let text = ron_file::read(path)?;
+    let map: BTreeMap<String, Material> = ron_file::parse(&text, path)?;
     for (name, m) in &map {
         m.validate().map_err(|e| SceneError::Value {
             path: path.into(),
@@ -156,15 +137,6 @@ pub fn load_materials(path: &Path) -> Result<BTreeMap<String, Material>, SceneEr
         })?;
     }
     Ok(map)
-}
-
-fn syntax(path: &Path, e: ron::error::SpannedError) -> SceneError {
-    SceneError::Syntax {
-        path: path.into(),
-        line: e.span.start.line,
-        col: e.span.start.col,
-        msg: e.code.to_string(),
-    }
 }
 
 /// 1-based line of the dotted `field` in scene text (0 when not found): the first line of

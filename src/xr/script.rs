@@ -197,15 +197,7 @@ impl HeadsetScript {
 
     /// Parse and check a script's text (`path` names it in errors).
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let s: HeadsetScript = ron::from_str(text).map_err(|e| {
-            anyhow::anyhow!(
-                "{}:{}:{}: {}",
-                path.display(),
-                e.span.start.line,
-                e.span.start.col,
-                e.code
-            )
-        })?;
+        let s: HeadsetScript = incise_sim::ron_file::parse(text, path)?;
         s.validate().with_context(|| path.display().to_string())?;
         Ok(s)
     }

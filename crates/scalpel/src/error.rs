@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+use incise_sim::ron_file::{ReadError, SyntaxError};
+
 /// A value that parsed but cannot be used, named by its dotted field path.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{field}: {msg}")]
@@ -28,25 +30,11 @@ impl FieldError {
 #[non_exhaustive]
 pub enum FileError {
     /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// OS error.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] ReadError),
     /// RON syntax, unknown field, wrong type: ron's position and message.
-    #[error("{path}:{line}:{col}: {msg}")]
-    Syntax {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        col: usize,
-        /// ron's message (names the field).
-        msg: String,
-    },
+    #[error(transparent)]
+    Syntax(#[from] SyntaxError),
     /// A value parsed but is out of range.
     #[error("{path}:{line}: {field}: {msg}")]
     Value {

@@ -1,29 +1,9 @@
-//! Reading RON text: syntax errors with file:line:col, and the line a dotted field path
-//! (`poses[3].rotation`, `spheres.radius`) sits on, for value errors.
+//! Placing value errors in RON text: the line a dotted field path (`poses[3].rotation`,
+//! `spheres.radius`) sits on. Reading and syntax errors are `incise_sim::ron_file`'s.
 
 use std::path::Path;
 
-use serde::de::DeserializeOwned;
-
 use crate::error::{FieldError, FileError};
-
-/// Read a file to a string, naming the file on failure.
-pub(crate) fn read(path: &Path) -> Result<String, FileError> {
-    std::fs::read_to_string(path).map_err(|source| FileError::Io {
-        path: path.into(),
-        source,
-    })
-}
-
-/// Parse RON `text`; `path` names it in errors.
-pub(crate) fn parse<T: DeserializeOwned>(text: &str, path: &Path) -> Result<T, FileError> {
-    ron::from_str(text).map_err(|e| FileError::Syntax {
-        path: path.into(),
-        line: e.span.start.line,
-        col: e.span.start.col,
-        msg: e.code.to_string(),
-    })
-}
 
 /// A field error placed in the file: its line found from the field path.
 pub(crate) fn value_error(text: &str, path: &Path, e: FieldError) -> FileError {

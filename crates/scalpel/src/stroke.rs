@@ -6,6 +6,7 @@ use std::path::Path;
 
 use glam::{Quat, Vec3};
 use incise_sim::contact::ToolPose;
+use incise_sim::ron_file;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{FieldError, FileError};
@@ -52,13 +53,13 @@ const UNIT_TOLERANCE: f32 = 1e-3;
 
 /// Read and validate a stroke file.
 pub fn load_stroke(path: &Path) -> Result<Stroke, FileError> {
-    let text = ron_text::read(path)?;
+    let text = ron_file::read(path)?;
     parse_stroke(&text, path)
 }
 
 /// Parse and validate stroke RON text; `path` names it in errors.
 pub fn parse_stroke(text: &str, path: &Path) -> Result<Stroke, FileError> {
-    let file: StrokeFile = ron_text::parse(text, path)?;
+    let file: StrokeFile = ron_file::parse(text, path)?;
     Stroke::new(file.poses).map_err(|e| ron_text::value_error(text, path, e))
 }
 

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use glam::{Quat, Vec2, Vec3};
 use incise_sim::contact::{ContactTool, ToolBox, ToolSphere};
+use incise_sim::ron_file;
 use parry3d::shape::Compound;
 
 use crate::error::{FieldError, FileError};
@@ -49,13 +50,13 @@ pub struct Tool {
 
 /// Read, check and convert a tool file (`config/tools/*.ron`).
 pub fn load_tool(path: &Path) -> Result<Tool, FileError> {
-    let text = ron_text::read(path)?;
+    let text = ron_file::read(path)?;
     parse_tool(&text, path)
 }
 
 /// Parse, check and convert tool RON text; `path` names it in errors.
 pub fn parse_tool(text: &str, path: &Path) -> Result<Tool, FileError> {
-    let spec: ToolSpec = ron_text::parse(text, path)?;
+    let spec: ToolSpec = ron_file::parse(text, path)?;
     Tool::from_spec(&spec).map_err(|e| ron_text::value_error(text, path, e))
 }
 

@@ -8,6 +8,7 @@ use incise_scalpel::{
     FileError, Incision, PoseKey, Stroke, StrokeRecorder, load_stroke, parse_stroke,
 };
 use incise_sim::contact::ToolPose;
+use incise_sim::ron_file::SyntaxError;
 use proptest::prelude::*;
 
 const GOOD: &str = "(
@@ -207,7 +208,7 @@ fn malformed_stroke_gives_line_and_column() {
         "(t: 0.4 position: (0.03, 0.005, -0.004)",
     );
     match parse_stroke(&bad, Path::new("s.ron")).unwrap_err() {
-        FileError::Syntax { line, col, .. } => {
+        FileError::Syntax(SyntaxError { line, col, .. }) => {
             assert_eq!(line, 5);
             assert!(col > 10);
         }

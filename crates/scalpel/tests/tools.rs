@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 use incise_scalpel::{FileError, SpherePlacement, load_tool, parse_tool};
+use incise_sim::ron_file::SyntaxError;
 
 fn tools_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../config/tools")
@@ -243,7 +244,7 @@ fn malformed_ron_gives_line_and_column() {
     let e = parse_tool(&bad, Path::new("bad.ron")).unwrap_err();
     let line = 1 + bad.lines().position(|l| l.contains("edge: [")).unwrap();
     match &e {
-        FileError::Syntax { line: l, col, .. } => {
+        FileError::Syntax(SyntaxError { line: l, col, .. }) => {
             assert_eq!(*l, line, "{e}");
             assert!(*col > 1, "{e}");
         }

@@ -18,6 +18,7 @@ pub mod material;
 pub mod mesh;
 pub mod nakao_cut;
 pub mod rheology;
+pub mod ron_file;
 pub mod selection;
 pub mod skin;
 pub mod stress;

@@ -1,29 +1,33 @@
 //! Opening one wgpu device that both renders and runs the GPU solver, so the renderer can
 //! read the solver's node positions without a round trip through the host.
 
-use incise_sim::gpu::GpuContext;
+use incise_sim::gpu::{
+    DeviceRequest, GpuContext, OpenError, OpenedDevice, describe_adapter, open_device,
+};
 
 use crate::error::RenderError;
 
-/// Storage buffers per stage the GPU solver's stress kernel needs (and more than the
-/// renderer's five).
-const STORAGE_BUFFERS: u32 = 8;
+/// One device for rendering and the solver: the adapter's texture limits too.
+const RENDER: DeviceRequest = DeviceRequest {
+    label: "incise",
+    needed_by: "incise",
+    textures: true,
+};
 
-/// An adapter's device and queue, opened for rendering and compute.
+/// An adapter's device and queue, opened for rendering and compute; its fields
+/// (adapter, device, queue, info, timestamps, limits) are the [`OpenedDevice`]'s.
 #[derive(Debug, Clone)]
-pub struct RenderDevice {
-    /// The adapter (for surface capabilities).
-    pub adapter: wgpu::Adapter,
-    /// The device.
-    pub device: wgpu::Device,
-    /// Its queue.
-    pub queue: wgpu::Queue,
-    /// What the adapter is.
-    pub info: wgpu::AdapterInfo,
-    /// Whether GPU timestamps can be taken in passes.
-    pub timestamps: bool,
-    /// The adapter's limits as granted.
-    pub limits: wgpu::Limits,
+pub struct RenderDevice(
+    /// The device as opened, by [`open_device`] or on the headset's Vulkan device.
+    pub OpenedDevice,
+);
+
+impl std::ops::Deref for RenderDevice {
+    type Target = OpenedDevice;
+
+    fn deref(&self) -> &OpenedDevice {
+        &self.0
+    }
 }
 
 impl RenderDevice {
@@ -75,85 +79,23 @@ impl RenderDevice {
         instance: &wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<Self, RenderError> {
-        let adapter = instance
-            .request_adapter(&wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                force_fallback_adapter: false,
-                compatible_surface: surface,
-                apply_limit_buckets: false,
-            })
+        let opened = open_device(instance, surface, &RENDER)
             .await
-            .map_err(|e| RenderError::NoAdapter(e.to_string()))?;
-        let info = adapter.get_info();
-        let available = adapter.limits();
-        if available.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS {
-            return Err(RenderError::Device {
-                adapter: info.name.clone(),
-                msg: format!(
-                    "it allows {} storage buffers per shader stage; incise needs {STORAGE_BUFFERS}",
-                    available.max_storage_buffers_per_shader_stage
-                ),
-            });
-        }
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let required_features = if timestamps {
-            wgpu::Features::TIMESTAMP_QUERY
-        } else {
-            wgpu::Features::empty()
-        };
-        let required_limits = wgpu::Limits {
-            max_storage_buffers_per_shader_stage: STORAGE_BUFFERS,
-            max_storage_buffer_binding_size: available.max_storage_buffer_binding_size,
-            max_buffer_size: available.max_buffer_size,
-            max_compute_workgroups_per_dimension: available.max_compute_workgroups_per_dimension,
-            max_texture_dimension_2d: available.max_texture_dimension_2d,
-            max_texture_array_layers: available.max_texture_array_layers,
-            ..wgpu::Limits::downlevel_defaults()
-        };
-        let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("incise"),
-                required_features,
-                required_limits: required_limits.clone(),
-                experimental_features: wgpu::ExperimentalFeatures::disabled(),
-                memory_hints: wgpu::MemoryHints::Performance,
-                trace: wgpu::Trace::Off,
-            })
-            .await
-            .map_err(|e| RenderError::Device {
-                adapter: info.name.clone(),
-                msg: e.to_string(),
+            .map_err(|e| match e {
+                OpenError::NoAdapter(why) => RenderError::NoAdapter(why),
+                OpenError::Refused { adapter, msg } => RenderError::Device { adapter, msg },
             })?;
-        Ok(RenderDevice {
-            adapter,
-            device,
-            queue,
-            info,
-            timestamps,
-            limits: required_limits,
-        })
+        Ok(RenderDevice(opened))
     }
 
     /// The same device as a [`GpuContext`] for the GPU solver (device loss and uncaptured
     /// errors are routed to the context's fault record from here on).
     pub fn compute_context(&self) -> GpuContext {
-        let fault = incise_sim::gpu::DeviceFault::default();
-        fault.watch(&self.device);
-        GpuContext {
-            fault,
-            device: self.device.clone(),
-            queue: self.queue.clone(),
-            info: self.info.clone(),
-            timestamps: self.timestamps,
-            max_binding: self.limits.max_storage_buffer_binding_size,
-        }
+        GpuContext::on(&self.0)
     }
 
     /// "name (backend, device type)" for reports.
     pub fn describe(&self) -> String {
-        format!(
-            "{} ({:?}, {:?})",
-            self.info.name, self.info.backend, self.info.device_type
-        )
+        describe_adapter(&self.info)
     }
 }

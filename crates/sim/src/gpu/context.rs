@@ -1,5 +1,14 @@
 //! Opening a wgpu device for compute: any adapter (a discrete GPU, or Mesa lavapipe in CI).
 
+use super::device::{DeviceRequest, OpenError, OpenedDevice, describe_adapter, open_device};
+
+/// The compute solver's own device.
+const COMPUTE: DeviceRequest = DeviceRequest {
+    label: "incise compute",
+    needed_by: "the stress kernel",
+    textures: false,
+};
+
 /// Why no GPU device could be opened or used.
 #[derive(Debug, Clone, thiserror::Error)]
 #[non_exhaustive]
@@ -56,6 +65,15 @@ pub struct GpuContext {
 #[derive(Debug, Clone, Default)]
 pub struct DeviceFault(std::sync::Arc<std::sync::Mutex<Option<String>>>);
 
+impl From<OpenError> for GpuError {
+    fn from(e: OpenError) -> Self {
+        match e {
+            OpenError::NoAdapter(why) => GpuError::NoAdapter(why),
+            OpenError::Refused { adapter, msg } => GpuError::Device { adapter, msg },
+        }
+    }
+}
+
 impl DeviceFault {
     /// Record `msg` unless a fault is already recorded.
     pub fn record(&self, msg: String) {
@@ -92,70 +110,27 @@ impl GpuContext {
     async fn open() -> Result<Self, GpuError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = instance
-            .request_adapter(&wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                force_fallback_adapter: false,
-                compatible_surface: None,
-                apply_limit_buckets: false,
-            })
-            .await
-            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
-        let info = adapter.get_info();
-        let available = adapter.limits();
-        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let required_features = if timestamps {
-            wgpu::Features::TIMESTAMP_QUERY
-        } else {
-            wgpu::Features::empty()
-        };
-        let required_limits = wgpu::Limits {
-            max_storage_buffers_per_shader_stage: 8,
-            max_storage_buffer_binding_size: available.max_storage_buffer_binding_size,
-            max_buffer_size: available.max_buffer_size,
-            max_compute_workgroups_per_dimension: available.max_compute_workgroups_per_dimension,
-            ..wgpu::Limits::downlevel_defaults()
-        };
-        if available.max_storage_buffers_per_shader_stage < 8 {
-            return Err(GpuError::Device {
-                adapter: info.name.clone(),
-                msg: format!(
-                    "it allows {} storage buffers per shader stage; the stress kernel needs 8",
-                    available.max_storage_buffers_per_shader_stage
-                ),
-            });
-        }
-        let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("incise compute"),
-                required_features,
-                required_limits,
-                experimental_features: wgpu::ExperimentalFeatures::disabled(),
-                memory_hints: wgpu::MemoryHints::Performance,
-                trace: wgpu::Trace::Off,
-            })
-            .await
-            .map_err(|e| GpuError::Device {
-                adapter: info.name.clone(),
-                msg: e.to_string(),
-            })?;
+        let opened = open_device(&instance, None, &COMPUTE).await?;
+        Ok(Self::on(&opened))
+    }
+
+    /// A context on `opened`'s device and queue (the same ones: wgpu handles are shared,
+    /// not copied), whose loss and uncaptured errors go to the new fault record from now on.
+    pub fn on(opened: &OpenedDevice) -> Self {
         let fault = DeviceFault::default();
-        fault.watch(&device);
-        Ok(GpuContext {
+        fault.watch(&opened.device);
+        GpuContext {
             fault,
-            device,
-            queue,
-            max_binding: available.max_storage_buffer_binding_size as u64,
-            info,
-            timestamps,
-        })
+            device: opened.device.clone(),
+            queue: opened.queue.clone(),
+            info: opened.info.clone(),
+            timestamps: opened.timestamps,
+            max_binding: opened.limits.max_storage_buffer_binding_size,
+        }
     }
 
     /// "name (backend, device type)" for reports.
     pub fn describe(&self) -> String {
-        format!(
-            "{} ({:?}, {:?})",
-            self.info.name, self.info.backend, self.info.device_type
-        )
+        describe_adapter(&self.info)
     }
 }

@@ -4,10 +4,14 @@
 //! the host mirror (mesh, cut state, guards, statistics), so those exist once.
 
 mod context;
+mod device;
 mod kernels;
 mod layout;
 mod solver;
 
 pub use context::{DeviceFault, GpuContext, GpuError};
+pub use device::{
+    DeviceRequest, OpenError, OpenedDevice, STORAGE_BUFFERS, describe_adapter, open_device,
+};
 pub use kernels::{SHADER_STAGES, shader_source};
 pub use solver::{GpuSolver, GpuTiming};

@@ -38,19 +38,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), MeshError> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::format_checks::scratch;
     use super::*;
-
-    fn scratch(name: &str) -> PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("incise-io-atomic-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create scratch dir");
-        dir
-    }
 
     #[test]
     fn replaces_file_and_leaves_no_temp() {
-        let dir = scratch("replace");
+        let dir = scratch("atomic-replace");
         let path = dir.join("frame.vtu");
         write_atomic(&path, b"old").expect("first write");
         write_atomic(&path, b"new contents").expect("second write");
@@ -62,7 +55,7 @@ mod tests {
 
     #[test]
     fn missing_directory_is_an_io_error_naming_the_file() {
-        let dir = scratch("missing");
+        let dir = scratch("atomic-missing");
         let path = dir.join("no/such/dir/out.vtk");
         let err = write_atomic(&path, b"x").expect_err("no directory");
         assert!(matches!(err, MeshError::Io { .. }));

@@ -5,11 +5,14 @@
 //! `.obj`. Simulation output: `.vtu` snapshots collected by a ParaView `.pvd` file.
 
 pub mod atomic;
+#[cfg(test)]
+mod format_checks;
 pub mod gmsh;
 pub mod obj;
 pub mod pvd;
 pub mod tetgen;
 pub mod text;
+pub mod vtk_cells;
 pub mod vtk_legacy;
 pub mod vtu;
 mod xml;
@@ -74,6 +77,7 @@ fn check_tets(node_count: usize, tets: &[[u32; 4]]) -> Result<(), MeshError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::format_checks::scratch;
 
     #[test]
     fn unknown_extensions_are_unsupported() {
@@ -98,9 +102,7 @@ mod tests {
 
     #[test]
     fn dispatch_reads_each_format_from_disk() {
-        let dir = std::env::temp_dir().join(format!("incise-io-dispatch-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let dir = scratch("dispatch");
         let positions = [
             glam::Vec3::ZERO,
             glam::Vec3::X,

@@ -117,6 +117,7 @@ fn vertex_index(line: &Fields<'_>, token: &str, seen: usize) -> Result<u32, Mesh
 
 #[cfg(test)]
 mod tests {
+    use super::super::format_checks::scratch;
     use super::*;
 
     const QUAD_AND_TRI: &str = "\
@@ -210,9 +211,7 @@ f -5 -4 -1
 
     #[test]
     fn write_then_read_round_trips() {
-        let dir = std::env::temp_dir().join(format!("incise-io-obj-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let dir = scratch("obj");
         let surface = TriSurface {
             positions: vec![
                 Vec3::new(0.1, 0.2, 0.3),

@@ -36,13 +36,12 @@ pub fn write_pvd(path: &Path, entries: &[(f64, String)]) -> Result<(), MeshError
 
 #[cfg(test)]
 mod tests {
+    use super::super::format_checks::scratch;
     use super::*;
 
     #[test]
     fn collection_lists_every_entry_in_order() {
-        let dir = std::env::temp_dir().join(format!("incise-io-pvd-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let dir = scratch("pvd");
         let path = dir.join("run.pvd");
         let entries = vec![
             (0.0, "frames/f_0000.vtu".to_string()),

@@ -184,6 +184,7 @@ fn expect_end(cursor: &mut Cursor<'_>, count: u64, what: &str) -> Result<(), Mes
 
 #[cfg(test)]
 mod tests {
+    use super::super::format_checks::scratch;
     use super::*;
 
     const NODE_1BASED: &str = "\
@@ -327,9 +328,7 @@ mod tests {
 
     #[test]
     fn write_then_load_round_trips_through_either_sibling() {
-        let dir = std::env::temp_dir().join(format!("incise-io-tetgen-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let dir = scratch("tetgen");
         let positions = vec![
             Vec3::ZERO,
             Vec3::new(0.1, 0.0, 0.0),

@@ -6,7 +6,6 @@
 //! types are skipped with one warning per type. `FIELD` data is skipped, and everything from
 //! `POINT_DATA`/`CELL_DATA` on is ignored.
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -14,21 +13,8 @@ use glam::Vec3;
 
 use super::atomic::write_atomic;
 use super::text::{Cursor, Fields, capacity, quote};
+use super::vtk_cells::{CellList, VTK_TETRA, tets_from_cells};
 use crate::{MeshError, RawMesh};
-
-/// VTK cell type of a linear tetrahedron.
-pub const VTK_TETRA: u32 = 10;
-/// VTK cell type of a quadratic (10-node) tetrahedron; its first four points are corners.
-pub const VTK_QUADRATIC_TETRA: u32 = 24;
-
-/// Cells as read: connectivity, and per cell its run in it and the line it starts on.
-#[derive(Debug, Default)]
-pub(super) struct CellList {
-    /// Point indices of all cells, concatenated.
-    pub conn: Vec<u32>,
-    /// Per cell: (start in `conn`, number of points, 1-based line where it starts).
-    pub runs: Vec<(usize, usize, usize)>,
-}
 
 /// Parse a legacy VTK ASCII unstructured grid; `origin` names it in errors.
 pub fn parse_vtk(text: &str, origin: &Path) -> Result<RawMesh, MeshError> {
@@ -135,72 +121,6 @@ pub fn write_vtk(path: &Path, positions: &[Vec3], tets: &[[u32; 4]]) -> Result<(
         let _ = writeln!(s, "{VTK_TETRA}");
     }
     write_atomic(path, s.as_bytes())
-}
-
-/// Human name of a VTK cell type.
-pub fn cell_type_name(ty: u32) -> Option<&'static str> {
-    Some(match ty {
-        1 => "vertex",
-        2 => "poly-vertex",
-        3 => "line",
-        4 => "poly-line",
-        5 => "triangle",
-        6 => "triangle strip",
-        7 => "polygon",
-        8 => "pixel",
-        9 => "quad",
-        10 => "tetra",
-        11 => "voxel",
-        12 => "hexahedron",
-        13 => "wedge",
-        14 => "pyramid",
-        21 => "quadratic edge",
-        22 => "quadratic triangle",
-        23 => "quadratic quad",
-        24 => "quadratic tetra",
-        25 => "quadratic hexahedron",
-        _ => return None,
-    })
-}
-
-/// Tets from cells and their types; other types become one warning per type.
-pub(super) fn tets_from_cells(
-    cells: &CellList,
-    types: &[u32],
-    origin: &Path,
-) -> Result<(Vec<[u32; 4]>, Vec<String>), MeshError> {
-    let mut tets = Vec::with_capacity(cells.runs.len());
-    let mut skipped: BTreeMap<u32, u64> = BTreeMap::new();
-    for (k, (&(start, len, line), &ty)) in cells.runs.iter().zip(types).enumerate() {
-        let need = match ty {
-            VTK_TETRA => 4,
-            VTK_QUADRATIC_TETRA => 10,
-            _ => {
-                *skipped.entry(ty).or_default() += 1;
-                continue;
-            }
-        };
-        if len != need {
-            return Err(MeshError::parse(
-                origin,
-                line,
-                format!("cell {k} has type {ty} ({need} points) but lists {len} points"),
-            ));
-        }
-        let c = &cells.conn[start..start + 4];
-        tets.push([c[0], c[1], c[2], c[3]]);
-    }
-    let warnings = skipped
-        .into_iter()
-        .map(|(ty, n)| {
-            let noun = if n == 1 { "cell" } else { "cells" };
-            match cell_type_name(ty) {
-                Some(name) => format!("skipped {n} {noun} of VTK type {ty} ({name})"),
-                None => format!("skipped {n} {noun} of VTK type {ty}"),
-            }
-        })
-        .collect();
-    Ok((tets, warnings))
 }
 
 /// The header line, the title line and `ASCII`.
@@ -386,6 +306,9 @@ fn skip_field(c: &mut Cursor<'_>, line: &mut Fields<'_>) -> Result<(), MeshError
 
 #[cfg(test)]
 mod tests {
+    use super::super::format_checks::{
+        assert_errors, assert_read_back, assert_two_tets_and_a_triangle, scratch,
+    };
     use super::*;
 
     const TWO_TETS: &str = "\
@@ -441,22 +364,9 @@ CELL_TYPES 3
         parse_vtk(text, Path::new("m.vtk"))
     }
 
-    fn err_text(text: &str) -> String {
-        vtk(text).expect_err("input is malformed").to_string()
-    }
-
     #[test]
     fn classic_layout_with_field_data_and_skipped_triangle() {
-        let raw = vtk(TWO_TETS).expect("valid");
-        assert_eq!(
-            raw.positions,
-            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE]
-        );
-        assert_eq!(raw.tets, vec![[0, 1, 2, 3], [1, 2, 3, 4]]);
-        assert_eq!(
-            raw.warnings,
-            vec!["skipped 1 cell of VTK type 5 (triangle)"]
-        );
+        assert_two_tets_and_a_triangle(&vtk(TWO_TETS).expect("valid"));
     }
 
     #[test]
@@ -475,94 +385,90 @@ CELL_TYPES 3
 
     #[test]
     fn out_of_range_point_names_the_cell_line() {
-        let msg = err_text(&TWO_TETS.replace("4 1 2 3 4", "4 1 2 3 5"));
-        assert!(
-            msg.contains("m.vtk:15: cell 2 references point 5, but POINTS has 5"),
-            "{msg}"
-        );
-        let msg = err_text(&VTK51.replace("0 1 2\n4", "0 1 2\n7"));
-        assert!(msg.contains("m.vtk:17: cell 2 references point 7"), "{msg}");
+        let cases = [
+            (
+                TWO_TETS.replace("4 1 2 3 4", "4 1 2 3 5"),
+                "m.vtk:15: cell 2 references point 5, but POINTS has 5",
+            ),
+            (
+                VTK51.replace("0 1 2\n4", "0 1 2\n7"),
+                "m.vtk:17: cell 2 references point 7",
+            ),
+        ];
+        assert_errors(vtk, &cases);
     }
 
     #[test]
     fn wrong_counts_are_errors_with_lines() {
-        let msg = err_text(&TWO_TETS.replace("1 1 1\nCELLS", "CELLS"));
-        assert!(
-            msg.contains("m.vtk:11: expected a coordinate of point 5 of 5, found \"CELLS\""),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("POINTS 5", "POINTS 4"));
-        assert!(
-            msg.contains("m.vtk:11: expected a keyword such as CELLS"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("CELLS 3 14", "CELLS 3 15"));
-        assert!(
-            msg.contains("m.vtk:12: CELLS announces a list of 15 numbers"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("CELL_TYPES 3", "CELL_TYPES 2"));
-        assert!(
-            msg.contains("m.vtk:16: CELL_TYPES announces 2 cells, but CELLS has 3"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("3 0 1 2", "4 0 1 2"));
-        assert!(
-            msg.contains("m.vtk:15: found \"3\" after the 3 cells announced"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("10 5", "10 10"));
-        assert!(
-            msg.contains("m.vtk:14: cell 1 has type 10 (4 points) but lists 3"),
-            "{msg}"
-        );
-        let msg = err_text(&VTK51.replace("0 4 7 8", "0 4 3 8"));
-        assert!(
-            msg.contains("m.vtk:13: offset 3 must start at 0, not decrease"),
-            "{msg}"
-        );
+        let cases = [
+            (
+                TWO_TETS.replace("1 1 1\nCELLS", "CELLS"),
+                "m.vtk:11: expected a coordinate of point 5 of 5, found \"CELLS\"",
+            ),
+            (
+                TWO_TETS.replace("POINTS 5", "POINTS 4"),
+                "m.vtk:11: expected a keyword such as CELLS",
+            ),
+            (
+                TWO_TETS.replace("CELLS 3 14", "CELLS 3 15"),
+                "m.vtk:12: CELLS announces a list of 15 numbers",
+            ),
+            (
+                TWO_TETS.replace("CELL_TYPES 3", "CELL_TYPES 2"),
+                "m.vtk:16: CELL_TYPES announces 2 cells, but CELLS has 3",
+            ),
+            (
+                TWO_TETS.replace("3 0 1 2", "4 0 1 2"),
+                "m.vtk:15: found \"3\" after the 3 cells announced",
+            ),
+            (
+                TWO_TETS.replace("10 5", "10 10"),
+                "m.vtk:14: cell 1 has type 10 (4 points) but lists 3",
+            ),
+            (
+                VTK51.replace("0 4 7 8", "0 4 3 8"),
+                "m.vtk:13: offset 3 must start at 0, not decrease",
+            ),
+        ];
+        assert_errors(vtk, &cases);
     }
 
     #[test]
     fn truncated_non_numeric_and_empty_inputs_are_errors() {
-        let cut = TWO_TETS.find("CELL_TYPES").unwrap_or(0);
-        let msg = err_text(&TWO_TETS[..cut]);
-        assert!(
-            msg.contains("m.vtk:15: unexpected end of file: expected a CELL_TYPES"),
-            "{msg}"
-        );
-        let cut = TWO_TETS.find("4 1 2 3 4").unwrap_or(0);
-        let msg = err_text(&TWO_TETS[..cut]);
-        assert!(
-            msg.contains("m.vtk:14: unexpected end of file: expected the point count"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("0 0 1\n", "0 O 1\n"));
-        assert!(
-            msg.contains("m.vtk:10: expected a coordinate of point 4 of 5, found \"O\""),
-            "{msg}"
-        );
-        let msg = err_text("");
-        assert!(msg.contains("m.vtk:0: the file is empty"), "{msg}");
-        let msg = err_text("# vtk DataFile Version 3.0\nt\nBINARY\n");
-        assert!(
-            msg.contains("m.vtk:3: binary .vtk is not supported"),
-            "{msg}"
-        );
-        let msg = err_text("# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\n");
-        assert!(
-            msg.contains("m.vtk:4: only DATASET UNSTRUCTURED_GRID is supported"),
-            "{msg}"
-        );
-        let msg = err_text("ply\nformat ascii 1.0\n");
-        assert!(msg.contains("m.vtk:1: expected the header"), "{msg}");
+        let before = |marker: &str| TWO_TETS[..TWO_TETS.find(marker).unwrap_or(0)].to_string();
+        let cases = [
+            (
+                before("CELL_TYPES"),
+                "m.vtk:15: unexpected end of file: expected a CELL_TYPES",
+            ),
+            (
+                before("4 1 2 3 4"),
+                "m.vtk:14: unexpected end of file: expected the point count",
+            ),
+            (
+                TWO_TETS.replace("0 0 1\n", "0 O 1\n"),
+                "m.vtk:10: expected a coordinate of point 4 of 5, found \"O\"",
+            ),
+            (String::new(), "m.vtk:0: the file is empty"),
+            (
+                "# vtk DataFile Version 3.0\nt\nBINARY\n".into(),
+                "m.vtk:3: binary .vtk is not supported",
+            ),
+            (
+                "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\n".into(),
+                "m.vtk:4: only DATASET UNSTRUCTURED_GRID is supported",
+            ),
+            (
+                "ply\nformat ascii 1.0\n".into(),
+                "m.vtk:1: expected the header",
+            ),
+        ];
+        assert_errors(vtk, &cases);
     }
 
     #[test]
     fn write_then_parse_round_trips() {
-        let dir = std::env::temp_dir().join(format!("incise-io-vtk-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
+        let dir = scratch("vtk");
         let positions: Vec<Vec3> = (0..7)
             .map(|i| {
                 Vec3::new(
@@ -576,12 +482,7 @@ CELL_TYPES 3
         let path = dir.join("mesh.vtk");
         write_vtk(&path, &positions, &tets).expect("write");
         let raw = super::super::load_mesh(&path).expect("read back");
-        assert_eq!(raw.positions.len(), positions.len());
-        for (a, b) in raw.positions.iter().zip(&positions) {
-            assert!((*a - *b).abs().max_element() <= 1e-6 * b.abs().max_element().max(1.0));
-        }
-        assert_eq!(raw.tets, tets);
-        assert!(raw.warnings.is_empty());
+        assert_read_back(&raw, &positions, &tets);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

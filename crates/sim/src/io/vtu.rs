@@ -13,7 +13,7 @@ use glam::Vec3;
 
 use super::atomic::write_atomic;
 use super::text::{Cursor, capacity, quote};
-use super::vtk_legacy::{CellList, VTK_TETRA, tets_from_cells};
+use super::vtk_cells::{CellList, VTK_TETRA, tets_from_cells};
 use super::xml::{Scanner, Tag, TagKind, escape_attr};
 use crate::{MeshError, RawMesh};
 
@@ -484,6 +484,9 @@ fn vec3(s: &mut String, v: &Vec3) {
 
 #[cfg(test)]
 mod tests {
+    use super::super::format_checks::{
+        assert_errors, assert_read_back, assert_two_tets_and_a_triangle, scratch,
+    };
     use super::*;
 
     const TWO_TETS: &str = r#"<?xml version="1.0"?>
@@ -519,118 +522,86 @@ mod tests {
         parse_vtu(text, Path::new("m.vtu"))
     }
 
-    fn err_text(text: &str) -> String {
-        vtu(text).expect_err("input is malformed").to_string()
-    }
-
-    fn scratch(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("incise-io-vtu-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("scratch dir");
-        dir
-    }
-
     #[test]
     fn hand_written_file_parses_and_skips_the_triangle() {
-        let raw = vtu(TWO_TETS).expect("valid");
-        assert_eq!(
-            raw.positions,
-            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, Vec3::ONE]
-        );
-        assert_eq!(raw.tets, vec![[0, 1, 2, 3], [1, 2, 3, 4]]);
-        assert_eq!(
-            raw.warnings,
-            vec!["skipped 1 cell of VTK type 5 (triangle)"]
-        );
+        assert_two_tets_and_a_triangle(&vtu(TWO_TETS).expect("valid"));
     }
 
     #[test]
     fn malformed_arrays_name_their_lines() {
-        let msg = err_text(&TWO_TETS.replace("1 2 3 4\n", "1 2 3 5\n"));
-        assert!(
-            msg.contains("m.vtu:21: connectivity references point 5, but NumberOfPoints is 5"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("0 1 0 0 0 1", "0 1 0 0 x 1"));
-        assert!(
-            msg.contains("m.vtu:12: expected a coordinate of point 4 of 5, found \"x\""),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("          1 1 1\n", ""));
-        assert!(
-            msg.contains(
-                "m.vtu:13: the Points DataArray ends early: expected a coordinate of point 5 of 5"
+        let cases = [
+            (
+                TWO_TETS.replace("1 2 3 4\n", "1 2 3 5\n"),
+                "m.vtu:21: connectivity references point 5, but NumberOfPoints is 5",
             ),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("NumberOfPoints=\"5\"", "NumberOfPoints=\"4\""));
-        assert!(
-            msg.contains("m.vtu:13: found \"1\" after the 4 points"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("4 7 11<", "4 7<"));
-        assert!(
-            msg.contains("m.vtu:17: offsets has 2 values, but NumberOfCells is 3"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("10 5 10", "10 10 10"));
-        assert!(
-            msg.contains("m.vtu:20: cell 1 has type 10 (4 points) but lists 3"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("4 7 11<", "4 7 12<"));
-        assert!(msg.contains("m.vtu:17: offset 12 is out of order"), "{msg}");
+            (
+                TWO_TETS.replace("0 1 0 0 0 1", "0 1 0 0 x 1"),
+                "m.vtu:12: expected a coordinate of point 4 of 5, found \"x\"",
+            ),
+            (
+                TWO_TETS.replace("          1 1 1\n", ""),
+                "m.vtu:13: the Points DataArray ends early: expected a coordinate of point 5 of 5",
+            ),
+            (
+                TWO_TETS.replace("NumberOfPoints=\"5\"", "NumberOfPoints=\"4\""),
+                "m.vtu:13: found \"1\" after the 4 points",
+            ),
+            (
+                TWO_TETS.replace("4 7 11<", "4 7<"),
+                "m.vtu:17: offsets has 2 values, but NumberOfCells is 3",
+            ),
+            (
+                TWO_TETS.replace("10 5 10", "10 10 10"),
+                "m.vtu:20: cell 1 has type 10 (4 points) but lists 3",
+            ),
+            (
+                TWO_TETS.replace("4 7 11<", "4 7 12<"),
+                "m.vtu:17: offset 12 is out of order",
+            ),
+        ];
+        assert_errors(vtu, &cases);
     }
 
     #[test]
     fn structural_errors_are_clear() {
-        let msg = err_text(&TWO_TETS.replace("\"ascii\">\n          0 0 0", "\"binary\">\n 0 0 0"));
-        assert!(
-            msg.contains("m.vtu:10: the Points DataArray has format=\"binary\""),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("UnstructuredGrid\" version", "PolyData\" version"));
-        assert!(
-            msg.contains("m.vtu:3: only VTKFile type=\"UnstructuredGrid\""),
-            "{msg}"
-        );
-        let cut = TWO_TETS.find("</Piece>").unwrap_or(0);
-        let msg = err_text(&TWO_TETS[..cut]);
-        assert!(
-            msg.contains("m.vtu:5: this <Piece> is never closed"),
-            "{msg}"
-        );
-        let cut = TWO_TETS.find("1 1 1").unwrap_or(0);
-        let msg = err_text(&TWO_TETS[..cut]);
-        assert!(
-            msg.contains("m.vtu:10: this element is never closed with </DataArray>"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace("<Piece NumberOfPoints", "<Piece NumberOfPoints=5 x"));
-        assert!(
-            msg.contains("m.vtu:5: malformed tag: the value of NumberOfPoints"),
-            "{msg}"
-        );
-        let msg = err_text(&TWO_TETS.replace(
-            r#"<DataArray type="UInt8" Name="types" format="ascii">10 5 10</DataArray>"#,
-            "",
-        ));
-        assert!(
-            msg.contains("m.vtu:5: this <Piece> has no types array"),
-            "{msg}"
-        );
-        let msg = err_text("");
-        assert!(msg.contains("m.vtu:0: the file is empty"), "{msg}");
-        let msg = err_text("<?xml version=\"1.0\"?>\n<!-- nothing\n");
-        assert!(
-            msg.contains("m.vtu:2: this markup is never closed"),
-            "{msg}"
-        );
+        let before = |marker: &str| TWO_TETS[..TWO_TETS.find(marker).unwrap_or(0)].to_string();
+        let cases = [
+            (
+                TWO_TETS.replace("\"ascii\">\n          0 0 0", "\"binary\">\n 0 0 0"),
+                "m.vtu:10: the Points DataArray has format=\"binary\"",
+            ),
+            (
+                TWO_TETS.replace("UnstructuredGrid\" version", "PolyData\" version"),
+                "m.vtu:3: only VTKFile type=\"UnstructuredGrid\"",
+            ),
+            (before("</Piece>"), "m.vtu:5: this <Piece> is never closed"),
+            (
+                before("1 1 1"),
+                "m.vtu:10: this element is never closed with </DataArray>",
+            ),
+            (
+                TWO_TETS.replace("<Piece NumberOfPoints", "<Piece NumberOfPoints=5 x"),
+                "m.vtu:5: malformed tag: the value of NumberOfPoints",
+            ),
+            (
+                TWO_TETS.replace(
+                    r#"<DataArray type="UInt8" Name="types" format="ascii">10 5 10</DataArray>"#,
+                    "",
+                ),
+                "m.vtu:5: this <Piece> has no types array",
+            ),
+            (String::new(), "m.vtu:0: the file is empty"),
+            (
+                "<?xml version=\"1.0\"?>\n<!-- nothing\n".into(),
+                "m.vtu:2: this markup is never closed",
+            ),
+        ];
+        assert_errors(vtu, &cases);
     }
 
     #[test]
     fn write_then_parse_round_trips_with_fields() {
-        let dir = scratch("roundtrip");
+        let dir = scratch("vtu-roundtrip");
         let positions: Vec<Vec3> = (0..6)
             .map(|i| Vec3::new(i as f32 * 0.013, -(i as f32), (i * i) as f32 * 1e-5))
             .collect();
@@ -648,19 +619,13 @@ mod tests {
         let text = std::fs::read_to_string(&path).expect("read");
         assert!(text.contains("Name=\"mass &lt;kg&gt;\""));
         assert!(text.contains("<DataArray type=\"Float32\" Name=\"von_mises\" format=\"ascii\">"));
-        let raw = vtu(&text).expect("parse back");
-        assert_eq!(raw.positions.len(), positions.len());
-        for (a, b) in raw.positions.iter().zip(&positions) {
-            assert!((*a - *b).abs().max_element() <= 1e-6, "{a} vs {b}");
-        }
-        assert_eq!(raw.tets, tets);
-        assert!(raw.warnings.is_empty());
+        assert_read_back(&vtu(&text).expect("parse back"), &positions, &tets);
         let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
     fn writer_rejects_mismatched_fields_by_name() {
-        let dir = scratch("mismatch");
+        let dir = scratch("vtu-mismatch");
         let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
         let tets = [[0, 1, 2, 3]];
         let two = [1.0f32, 2.0];
@@ -703,7 +668,7 @@ mod tests {
 
     #[test]
     fn empty_frame_writes_a_valid_empty_grid() {
-        let dir = scratch("empty");
+        let dir = scratch("vtu-empty");
         let path = dir.join("empty.vtu");
         write_vtu(&path, &VtuFrame::default()).expect("write");
         let raw = super::super::load_mesh(&path).expect("parse");

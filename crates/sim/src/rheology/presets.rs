@@ -5,31 +5,18 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use super::material::RheologyMaterial;
+use crate::ron_file::{self, ReadError, SyntaxError};
 
 /// Why a preset file could not be used.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum PresetError {
     /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// OS error.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] ReadError),
     /// RON syntax, unknown or missing field, wrong type.
-    #[error("{path}:{line}:{col}: {message}")]
-    Syntax {
-        /// The file.
-        path: PathBuf,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        col: usize,
-        /// ron's message (names the field).
-        message: String,
-    },
+    #[error(transparent)]
+    Syntax(#[from] SyntaxError),
     /// A value is out of range.
     #[error("{path}:{line}: preset \"{preset}\": {field} {message}")]
     Value {
@@ -68,22 +55,13 @@ pub struct RheologyPresets {
 impl RheologyPresets {
     /// Read and check a preset file.
     pub fn load(path: &Path) -> Result<Self, PresetError> {
-        let text = std::fs::read_to_string(path).map_err(|source| PresetError::Io {
-            path: path.into(),
-            source,
-        })?;
+        let text = ron_file::read(path)?;
         Self::parse(&text, path)
     }
 
     /// Parse and check preset text; `path` names it in errors.
     pub fn parse(text: &str, path: &Path) -> Result<Self, PresetError> {
-        let materials: BTreeMap<String, RheologyMaterial> =
-            ron::from_str(text).map_err(|e| PresetError::Syntax {
-                path: path.into(),
-                line: e.span.start.line,
-                col: e.span.start.col,
-                message: e.code.to_string(),
-            })?;
+        let materials: BTreeMap<String, RheologyMaterial> = ron_file::parse(text, path)?;
         for (name, m) in &materials {
             if let Some((field, message)) = m.problem() {
                 let key = format!("\"{name}\"");

@@ -12,6 +12,7 @@ use std::ffi::c_char;
 
 use ::openxr as xr;
 use ash::vk::{self, Handle};
+use incise_sim::gpu::OpenedDevice;
 use wgpu::hal::{self, vulkan as hal_vk};
 
 use super::error::{XrError, xr_call};
@@ -333,14 +334,14 @@ pub fn create_gpu(creator: &impl VulkanCreator) -> Result<XrGpu, XrError> {
             )
             .map_err(|e| gpu_err("wgpu device")(e.to_string()))?;
         Ok(XrGpu {
-            device: RenderDevice {
+            device: RenderDevice(OpenedDevice {
                 adapter,
                 device,
                 queue,
                 info,
                 timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
                 limits,
-            },
+            }),
             vk_instance: raw_instance.as_raw(),
             vk_physical_device: phd.as_raw(),
             vk_device: raw_device.as_raw(),
