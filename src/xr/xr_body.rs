@@ -330,7 +330,16 @@ mod tests {
         let s = xr.solver();
         assert_eq!(s.params().substeps, min);
         assert_eq!(s.positions(), &before[..]);
-        assert_eq!(s.velocities(), &moving[..], "the motion goes on");
+        let changed = s
+            .velocities()
+            .iter()
+            .zip(&moving)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(
+            changed, 0,
+            "the motion goes on: {changed} velocities changed"
+        );
         assert_eq!(pinned_nodes(s), pins, "pins kept");
         assert_eq!(released_tets(s), cut, "the cut kept");
         let motion = s.tool().expect("the scalpel stays attached");
