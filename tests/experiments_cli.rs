@@ -156,20 +156,7 @@ fn creep_closed_form(t: f64) -> f64 {
 /// the block's shape under gravity.
 #[test]
 fn quick_rheology_matches_the_closed_form_and_the_presets() {
-    let out = temp_dir("exp-rheology-quick");
-    let o = incise(&[
-        "experiment",
-        "rheology",
-        "--quick",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let printed = text(&o.stdout);
-    assert_eq!(
-        printed,
-        std::fs::read_to_string(out.join("summary.txt")).unwrap()
-    );
+    let (out, printed) = quick_experiment("rheology", "summary.txt");
     // Creep: every sample within 0.1 % of the peak; the peak 15 mm at release and the
     // damper's 10 mm residual at 3 s.
     let creep: Vec<Vec<f64>> = csv_rows(&out.join("creep.csv"))
@@ -235,20 +222,7 @@ fn quick_rheology_matches_the_closed_form_and_the_presets() {
 /// ends; the wound opens under 4 % tension and not without it.
 #[test]
 fn quick_nakao_plate_cuts_the_plate_as_its_geometry_says() {
-    let out = temp_dir("exp-nakao-quick");
-    let o = incise(&[
-        "experiment",
-        "nakao-plate",
-        "--quick",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let printed = text(&o.stdout);
-    assert_eq!(
-        printed,
-        std::fs::read_to_string(out.join("table.md")).unwrap()
-    );
+    let (out, printed) = quick_experiment("nakao-plate", "table.md");
     assert!(printed.starts_with("Quick version"), "{printed}");
     let rows = csv_rows(&out.join("table.csv"));
     let case = |sub: &str, tension: f64| {
@@ -391,4 +365,24 @@ fn experiment_substeps_compares_the_budget_with_the_reference() {
         !updated.contains("old") && updated.contains("| config/plate_cut.ron | 200 | reference |"),
         "{updated}"
     );
+}
+
+/// Run `incise experiment NAME --quick` into a scratch folder; what it printed must be
+/// the file `printed_file` it wrote there. Returns the folder and the printed text.
+fn quick_experiment(name: &str, printed_file: &str) -> (std::path::PathBuf, String) {
+    let out = temp_dir(&format!("exp-{name}-quick"));
+    let o = incise(&[
+        "experiment",
+        name,
+        "--quick",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let printed = text(&o.stdout);
+    assert_eq!(
+        printed,
+        std::fs::read_to_string(out.join(printed_file)).unwrap()
+    );
+    (out, printed)
 }
