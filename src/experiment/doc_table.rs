@@ -6,13 +6,18 @@ use std::path::Path;
 use anyhow::{Context, Result, bail};
 
 /// Replace the text from the `begin` line through the `end` line of `file` by `table`
-/// (which carries both markers itself).
-pub fn replace_between(file: &Path, begin: &str, end: &str, table: &str) -> Result<()> {
+/// (which carries both markers itself); `what` names the table in the error.
+pub fn replace_between(
+    file: &Path,
+    what: &str,
+    (begin, end): (&str, &str),
+    table: &str,
+) -> Result<()> {
     let text =
         std::fs::read_to_string(file).with_context(|| format!("reading {}", file.display()))?;
     let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
         bail!(
-            "{}: no generated table to update: add the marker lines `{begin}` and `{end}` first",
+            "{}: no {what} table to update (add the two marker lines `{begin}` and `{end}` first)",
             file.display()
         );
     };

@@ -139,17 +139,7 @@ pub fn parse(text: &str) -> Result<Vec<SceneFigure>> {
 
 /// Replace the generated table in `file` by `table` (from [`markdown`]).
 pub fn update(file: &Path, table: &str) -> Result<()> {
-    let text =
-        std::fs::read_to_string(file).with_context(|| format!("reading {}", file.display()))?;
-    let (Some(a), Some(b)) = (text.find(BEGIN), text.find(END)) else {
-        bail!(
-            "{}: no scene-figures table to update (add the two marker lines first)",
-            file.display()
-        );
-    };
-    let end = b + END.len() + usize::from(text[b + END.len()..].starts_with('\n'));
-    let new = format!("{}{table}{}", &text[..a], &text[end..]);
-    std::fs::write(file, new).with_context(|| format!("writing {}", file.display()))
+    super::doc_table::replace_between(file, "scene-figures", (BEGIN, END), table)
 }
 
 /// Measure `scenes`, print the table, and with `update` rewrite it in that file.
