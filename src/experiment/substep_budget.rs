@@ -12,7 +12,6 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use glam::Vec3;
 use incise_sim::Solver;
-use incise_sim::xpbd::{stiffness_number, substeps_needed};
 
 use crate::scene::{build_scene, load_scene};
 
@@ -174,18 +173,10 @@ fn row(
 /// The fewest substeps the stability bound allows for `scene` (κ ≤ 1 at the worst tet).
 fn bound_substeps(scene_path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     let scene = load_scene(scene_path)?;
-    let built = build_scene(&scene, scene_path, None)?;
-    let s = &built.solver;
-    let inv_mass: Vec<f32> = s
-        .masses()
-        .iter()
-        .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
-        .collect();
-    let n = s.params().substeps;
-    let (kappa, _) = stiffness_number(s.mesh(), &inv_mass, s.lame(), s.params().substep());
+    let s = build_scene(&scene, scene_path, None)?.solver;
     Ok((
-        substeps_needed(kappa, n).max(1),
-        n,
+        s.fewest_stable_substeps().max(1),
+        s.params().substeps,
         s.mesh().rest_positions.clone(),
     ))
 }
@@ -274,7 +265,7 @@ pub fn run(scenes: &[PathBuf], frames: u32, update_file: Option<&Path>) -> Resul
     }
     let table = markdown(&rows, frames);
     if let Some(file) = update_file {
-        super::doc_table::replace_between(file, BEGIN, END, &table)?;
+        super::doc_table::replace_between(file, "substep-budget", (BEGIN, END), &table)?;
     }
     Ok(table)
 }

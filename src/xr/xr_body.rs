@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use glam::{Quat, Vec3};
 use incise_sim::contact::{ContactTool, ToolPose};
 use incise_sim::skin::Skin;
-use incise_sim::xpbd::{FrameStats, stiffness_number, substeps_needed};
+use incise_sim::xpbd::FrameStats;
 use incise_sim::{Material, Solver};
 use incise_xr::RenderDevice;
 use incise_xr::frame::pinned_nodes;
@@ -89,18 +89,7 @@ impl XrBody {
         let pose = parked(&solver);
         solver.set_tool(sharp.dulled(), pose)?;
         let nominal = solver.params().substeps;
-        let inv_mass: Vec<f32> = solver
-            .masses()
-            .iter()
-            .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
-            .collect();
-        let (kappa, _) = stiffness_number(
-            solver.mesh(),
-            &inv_mass,
-            solver.lame(),
-            solver.params().substep(),
-        );
-        let min_substeps = substeps_needed(kappa, nominal).clamp(1, nominal);
+        let min_substeps = solver.fewest_stable_substeps().clamp(1, nominal);
         let body = place_on(solver, device, dev)?;
         Ok((
             XrBody {

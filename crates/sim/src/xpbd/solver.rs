@@ -272,6 +272,19 @@ impl Solver {
         }
     }
 
+    /// The fewest substeps per frame the stability bound allows (κ ≤
+    /// [`MAX_STIFFNESS_NUMBER`] at the worst tet, from every node's own mass, as
+    /// [`Solver::new`] checks it).
+    pub fn fewest_stable_substeps(&self) -> u32 {
+        let inv_mass: Vec<f32> = self
+            .mass
+            .iter()
+            .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
+            .collect();
+        let (kappa, _) = stiffness_number(&self.mesh, &inv_mass, self.lame, self.params.substep());
+        substeps_needed(kappa, self.params.substeps)
+    }
+
     /// Lumped node masses, kg.
     pub fn masses(&self) -> &[f32] {
         &self.mass
