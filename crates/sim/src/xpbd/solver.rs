@@ -577,32 +577,22 @@ impl Solver {
         let lanes = self.params.cpu_kernel == CpuKernel::Lanes
             && pair == ConstraintPair::RestFree
             && mode == TetProjection::Coupled;
-        if lanes {
-            let run = |(s, l): (&[TetSlot], &mut [f32])| {
+        // One run of consecutive slots: eight at a time in SIMD lanes, else one by one.
+        let run = |(s, l): (&[TetSlot], &mut [f32])| {
+            if lanes {
                 // SAFETY: tets of one colour share no node, and each run is one task's.
                 unsafe { lane_pass::project_run(s, l, &nodes, inv_mass) }
-            };
-            if parallel && slots.len() > CHUNK {
-                slots
-                    .par_chunks(CHUNK)
-                    .zip(lambdas.par_chunks_mut(CHUNK))
-                    .for_each(run);
             } else {
-                run((slots, lambdas));
+                s.iter().zip(l).for_each(|(s, l)| work(s, l));
             }
-            return;
-        }
+        };
         if parallel && slots.len() > CHUNK {
             slots
-                .par_iter()
-                .zip(lambdas.par_iter_mut())
-                .with_min_len(CHUNK)
-                .for_each(|(s, l)| work(s, l));
+                .par_chunks(CHUNK)
+                .zip(lambdas.par_chunks_mut(CHUNK))
+                .for_each(run);
         } else {
-            slots
-                .iter()
-                .zip(lambdas.iter_mut())
-                .for_each(|(s, l)| work(s, l));
+            run((slots, lambdas));
         }
     }
 
