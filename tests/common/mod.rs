@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod pixels;
+pub mod xr_report;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
