@@ -4,6 +4,9 @@
 
 mod common;
 
+use common::stretched_bar::{
+    middle_lateral_stretch, middle_stretch, middle_tets, plane_side, stretched_bar,
+};
 use common::{block_mesh, soft, solver, solver_at_kappa};
 use glam::{UVec3, Vec3};
 use incise_sim::grab::Grab;
@@ -142,68 +145,17 @@ fn simple_shear_matches_the_closed_form() {
 #[test]
 fn free_uniaxial_tension_matches_the_closed_form() {
     for strain in [0.1f32, 0.3] {
-        let (len, w) = (0.1f32, 0.01f32);
-        let mesh = block_mesh(
-            Vec3::new(0.0, -w / 2.0, -w / 2.0),
-            Vec3::new(len, w, w),
-            UVec3::new(20, 2, 2),
-        );
-        let params = SolverParams {
-            gravity: Vec3::ZERO,
-            damping: 20.0,
-            threads: 1,
-            ..SolverParams::default()
-        };
         let m = soft(20e3, 0.45);
-        let mut s = solver_at_kappa(mesh, m, params, 0.02);
-        let rest = s.mesh().rest_positions.clone();
-        let end = |x: f32, n: f32| plane_side(&rest, x, n);
-        s.pin(&end(1e-5, -1.0));
-        s.add_grab(Grab {
-            nodes: end(len - 1e-5, 1.0),
-            waypoints: vec![Vec3::X * (strain * len)],
-            speed: 0.2,
-            start_time: 0.0,
-        });
-        for _ in 0..150 {
-            s.step_frame().unwrap();
-        }
-        // Axial stretch between the planes at 35 % and 65 % of the length.
-        let x = s.positions();
-        let plane_x = |at: f32| {
-            let nodes: Vec<usize> = (0..rest.len())
-                .filter(|&i| (rest[i].x - at).abs() < 1e-5)
-                .collect();
-            nodes.iter().map(|&i| x[i].x).sum::<f32>() / nodes.len() as f32
-        };
-        let (a0, a1) = (0.35 * len, 0.65 * len);
-        let a = (plane_x(a1) - plane_x(a0)) / (a1 - a0);
+        let s = stretched_bar(m, strain);
+        let a = middle_stretch(&s);
         let (b, sxx) = uniaxial(m.lame(), a as f64);
-        let mid: Vec<usize> = (0..s.mesh().tet_count())
-            .filter(|&t| {
-                let c = s.mesh().tets[t]
-                    .iter()
-                    .map(|&i| rest[i as usize])
-                    .sum::<Vec3>()
-                    / 4.0;
-                c.x > a0 && c.x < a1
-            })
-            .collect();
+        let mid = middle_tets(&s);
         let mean = mid.iter().map(|&t| s.von_mises()[t] as f64).sum::<f64>() / mid.len() as f64;
         assert!(
             ((mean - sxx) / sxx).abs() < 0.01,
             "strain {strain}: stretch {a}, mean σvM {mean:.1} vs closed form {sxx:.1} Pa"
         );
-        let mid_y = |sign: f32| {
-            let nodes: Vec<usize> = (0..rest.len())
-                .filter(|&i| {
-                    (rest[i].x - 0.5 * len).abs() < 1e-5
-                        && (rest[i].y - sign * w / 2.0).abs() < 1e-6
-                })
-                .collect();
-            nodes.iter().map(|&i| x[i].y).sum::<f32>() / nodes.len() as f32
-        };
-        let lateral = (mid_y(1.0) - mid_y(-1.0)) / w;
+        let lateral = middle_lateral_stretch(&s);
         assert!(
             ((lateral as f64 - b) / (1.0 - b)).abs() < 0.05,
             "strain {strain}: lateral stretch {lateral} vs {b}"
@@ -260,14 +212,4 @@ fn release_does_not_depend_on_the_frame_rate() {
         (*hi - *lo) as f32 <= 0.1 * *lo as f32,
         "released counts differ by more than 10 %: {fixed:?}"
     );
-}
-
-/// Nodes on the `n` side (±1 along x) of the plane x = `x`.
-fn plane_side(rest: &[Vec3], x: f32, n: f32) -> Vec<u32> {
-    NodeSelection::PlaneSide {
-        point: Vec3::new(x, 0.0, 0.0),
-        normal: Vec3::X * n,
-    }
-    .select(rest)
-    .unwrap()
 }

@@ -1,6 +1,9 @@
 //! Shared set-up for the physics validation tests.
 #![allow(dead_code)]
 
+pub mod linear_fem;
+pub mod stretched_bar;
+
 use glam::{UVec3, Vec3};
 use incise_sim::generate::block;
 use incise_sim::xpbd::{stiffness_number, substeps_needed};
