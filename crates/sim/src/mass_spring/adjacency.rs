@@ -14,7 +14,7 @@ pub struct Rows {
 }
 
 impl Rows {
-    fn build(rows: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> Rows {
+    pub(crate) fn build(rows: usize, pairs: impl Iterator<Item = (u32, u32)> + Clone) -> Rows {
         let mut offsets = vec![0u32; rows + 1];
         for (r, _) in pairs.clone() {
             offsets[r as usize + 1] += 1;

@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 
+use super::god_object::{GodObject, ProxySurface};
 use super::{LocalLoop, LocalLoopParams, MassSpringModel, SystemClock};
 use crate::nakao_cut::{BladePose, CutParams, Cutter};
 
@@ -25,8 +26,11 @@ pub struct HapticConfig {
     pub local: LocalLoopParams,
     /// Stiffness of the virtual spring between the tool tip and the nearest node, N/m.
     pub coupling: f64,
-    /// The tool touches the tissue when its tip is within this distance of a node, m.
+    /// The tool touches the tissue when its tip is within this distance of a node, m
+    /// ([`HapticContact::NearestNode`] only).
     pub contact_radius: f64,
+    /// How the tool point is coupled to the tissue.
+    pub contact: HapticContact,
     /// Settings of the cutter that cuts along the blade poses (see [`HapticLoop::set_blade`]).
     pub cut: CutParams,
 }
@@ -39,9 +43,25 @@ impl Default for HapticConfig {
             local: LocalLoopParams::default(),
             coupling: 50.0,
             contact_radius: 0.005,
+            contact: HapticContact::default(),
             cut: CutParams::default(),
         }
     }
+}
+
+/// The coupling of the tool point to the tissue, both a virtual spring of stiffness
+/// [`HapticConfig::coupling`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum HapticContact {
+    /// To the node nearest the tip, within [`HapticConfig::contact_radius`]: pulls as well
+    /// as pushes (a blade held in the cut), and the force steps when the nearest node
+    /// changes (default; what the cutting runs use).
+    #[default]
+    NearestNode,
+    /// To a god object riding the surface (Zilles & Salisbury 1995, [`GodObject`]): a
+    /// probe pushes the surface in and feels it push back, never pulls, and cannot pass
+    /// through the body.
+    GodObject,
 }
 
 /// What the haptic thread last published.
@@ -142,6 +162,7 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
     let mut local = LocalLoop::new(config.local.clone(), SystemClock::default());
     let mut cutter = Cutter::new(config.cut.clone());
     let mut blade_seen: Option<BladePose> = None;
+    let mut couple = Coupling::new(&config);
     let mut next = Instant::now() + period;
     let (mut loops, mut overruns, mut snapshots, mut cuts) = (0u64, 0u64, 0u64, 0u64);
     while !shared.stop.load(Ordering::Acquire) {
@@ -161,31 +182,15 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
         let h = period.as_secs_f64();
         let substeps = (h / model.stable_dt()).ceil().max(1.0) as u32;
         let dt = h / substeps as f64;
-        let mut force = DVec3::ZERO;
-        let mut free = 0;
-        match tip {
-            Some(tip) => {
-                let node = local.hierarchy().nearest_node(&model, tip);
-                let touching = node.filter(|&n| {
-                    (model.positions()[n as usize] - tip).length() <= config.contact_radius
-                });
-                for _ in 0..substeps {
-                    if let Some(n) = touching {
-                        let f = config.coupling * (tip - model.positions()[n as usize]);
-                        model.set_external_force(n, f);
-                        force = -f;
-                    }
-                    free = local.step(&mut model, tip, dt).free_nodes;
-                }
-                model.clear_external_forces();
-            }
+        let (force, free) = match tip {
+            Some(tip) => couple.step(&mut model, &mut local, tip, substeps, dt),
             None => {
                 for _ in 0..substeps {
                     model.step(dt);
                 }
-                free = model.node_count();
+                (DVec3::ZERO, model.node_count())
             }
-        }
+        };
         loops += 1;
         let publish = loops % publish_every == 0;
         if let Ok(mut f) = shared.frame.lock() {
@@ -229,6 +234,87 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
     model
 }
 
+/// The tool's coupling in the loop: the settings and, for a god object, its proxy and the
+/// surface it rides (rebuilt when a cut changes the tets).
+struct Coupling {
+    contact: HapticContact,
+    stiffness: f64,
+    radius: f64,
+    god: GodObject,
+    surface: ProxySurface,
+}
+
+impl Coupling {
+    fn new(config: &HapticConfig) -> Self {
+        Coupling {
+            contact: config.contact,
+            stiffness: config.coupling,
+            radius: config.contact_radius,
+            god: GodObject::default(),
+            surface: ProxySurface::default(),
+        }
+    }
+
+    /// One loop's `substeps` with the tool at `tip`: the force on the tool, N, and the free
+    /// nodes of the last localised step.
+    fn step(
+        &mut self,
+        model: &mut MassSpringModel,
+        local: &mut LocalLoop<SystemClock>,
+        tip: DVec3,
+        substeps: u32,
+        dt: f64,
+    ) -> (DVec3, usize) {
+        let nodes = self.nodes(model, local, tip);
+        let mut force = DVec3::ZERO;
+        let mut free = 0;
+        for _ in 0..substeps {
+            if !nodes.is_empty() {
+                let x = model.positions();
+                let at: DVec3 = nodes.iter().map(|&(n, w)| x[n as usize] * w).sum();
+                force = self.stiffness * (at - tip);
+                for &(n, w) in &nodes {
+                    model.set_external_force(n, -force * w);
+                }
+            }
+            free = local.step(model, tip, dt).free_nodes;
+        }
+        model.clear_external_forces();
+        (force, free)
+    }
+
+    /// The nodes the tool pulls on this loop, with their weights (summing to 1); none when
+    /// the tool does not touch the tissue.
+    fn nodes(
+        &mut self,
+        model: &MassSpringModel,
+        local: &LocalLoop<SystemClock>,
+        tip: DVec3,
+    ) -> Vec<(u32, f64)> {
+        match self.contact {
+            HapticContact::NearestNode => local
+                .hierarchy()
+                .nearest_node(model, tip)
+                .filter(|&n| (model.positions()[n as usize] - tip).length() <= self.radius)
+                .map(|n| vec![(n, 1.0)])
+                .unwrap_or_default(),
+            HapticContact::GodObject => {
+                if self.surface.tet_count() != model.tet_count() {
+                    self.surface = ProxySurface::build(model.tets(), model.positions());
+                    self.god.rebind(&self.surface, model.positions());
+                }
+                self.god
+                    .update(tip, &self.surface, model.positions())
+                    .map(|c| {
+                        let t = self.surface.triangles()[c.triangle];
+                        (0..3).map(|k| (t[k], c.weights[k])).collect()
+                    })
+                    .unwrap_or_default()
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use glam::{UVec3, Vec3};
@@ -238,8 +324,8 @@ mod tests {
     use crate::mass_spring::{AxisMask, MassSpringParams};
     use crate::mesh::TetMesh;
 
-    #[test]
-    fn haptic_thread_runs_publishes_and_pushes_back() {
+    /// A 4 × 4 × 1 cm slab without gravity, held at its two x ends.
+    fn held_slab() -> MassSpringModel {
         let (mesh, _) = TetMesh::from_raw(block(
             Vec3::ZERO,
             Vec3::new(0.04, 0.04, 0.01),
@@ -261,6 +347,103 @@ mod tests {
             })
             .collect();
         m.fix(&rim, AxisMask::ALL).unwrap();
+        m
+    }
+
+    /// The tool's path in 1 kHz loops, run through [`Coupling::step`] without a thread:
+    /// the force on the tool each loop.
+    fn drive(m: &mut MassSpringModel, contact: HapticContact, path: &[DVec3]) -> Vec<DVec3> {
+        let config = HapticConfig {
+            contact,
+            ..HapticConfig::default()
+        };
+        let mut couple = Coupling::new(&config);
+        let mut local = LocalLoop::new(config.local.clone(), SystemClock::default());
+        let h = 1.0 / config.rate_hz;
+        let substeps = (h / m.stable_dt()).ceil().max(1.0) as u32;
+        path.iter()
+            .map(|&tip| {
+                couple
+                    .step(m, &mut local, tip, substeps, h / substeps as f64)
+                    .0
+            })
+            .collect()
+    }
+
+    /// The device at the slab's centre (x, y = 2.1, 1.9 cm) and height `z`, cm.
+    fn over_centre(z: f64) -> DVec3 {
+        DVec3::new(0.021, 0.019, z * 0.01)
+    }
+
+    /// A probe lowered into the slab, on through it and below it, held, and lifted: the god
+    /// object pushes the tool back up all the way (the proxy stays on the top face, so even
+    /// below the slab the force points up) and never pulls; the nearest-node coupling pulls
+    /// the tool down as it is lifted off, and lets go once the tool is below the slab.
+    #[test]
+    fn god_object_pushes_back_through_the_whole_press_and_never_pulls() {
+        let down: Vec<DVec3> = (0..=400)
+            .map(|k| over_centre(1.2 - 0.008 * k as f64))
+            .collect();
+        let hold = vec![over_centre(-2.0); 100];
+        let up: Vec<DVec3> = (0..=200)
+            .map(|k| over_centre(0.8 + 0.004 * k as f64))
+            .collect();
+        let path = [down.clone(), hold, up.clone()].concat();
+        let god = drive(&mut held_slab(), HapticContact::GodObject, &path);
+        let touch = (1.2 - 1.0) / 0.008;
+        assert!(
+            god[..touch as usize].iter().all(|f| *f == DVec3::ZERO),
+            "force before touching"
+        );
+        assert!(
+            god.iter().all(|f| f.z >= 0.0),
+            "the god object pulled the tool"
+        );
+        let at = |depth_cm: f64| god[((1.2 - 1.0 + depth_cm) / 0.008) as usize].z;
+        eprintln!(
+            "god object: force on the tool at 1, 3, 10, 20 mm deep: {:.3} {:.3} {:.3} {:.3} N",
+            at(0.1),
+            at(0.3),
+            at(1.0),
+            at(2.0)
+        );
+        assert!(
+            at(0.1) > 0.0 && at(0.3) > at(0.1) && at(1.0) > at(0.3) && at(2.0) > at(1.0),
+            "force did not grow with depth: {} {} {} {} N",
+            at(0.1),
+            at(0.3),
+            at(1.0),
+            at(2.0)
+        );
+        assert!(
+            god[500].z >= at(2.0) * 0.5,
+            "lost contact below the slab: {}",
+            god[500]
+        );
+        assert_eq!(
+            *god.last().unwrap(),
+            DVec3::ZERO,
+            "still touching when lifted off"
+        );
+        let near = drive(&mut held_slab(), HapticContact::NearestNode, &path);
+        assert!(
+            near[450].length() == 0.0,
+            "nearest node holds a tool 2 cm below the slab"
+        );
+        let lifted = drive(
+            &mut held_slab(),
+            HapticContact::NearestNode,
+            &[down[..250].to_vec(), up].concat(),
+        );
+        assert!(
+            lifted.iter().any(|f| f.z < 0.0),
+            "nearest node never pulled"
+        );
+    }
+
+    #[test]
+    fn haptic_thread_runs_publishes_and_pushes_back() {
+        let m = held_slab();
         let haptic = HapticLoop::spawn(m, HapticConfig::default());
         // Press the middle of the top surface 2 mm down.
         haptic.set_tool(Some(DVec3::new(0.02, 0.02, 0.008)));

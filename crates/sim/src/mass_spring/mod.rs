@@ -6,6 +6,7 @@
 
 mod adjacency;
 mod axes;
+mod god_object;
 mod haptic;
 mod hierarchy;
 mod integrate;
@@ -19,7 +20,8 @@ mod tet_tensor;
 
 pub use adjacency::{ElementIndex, Rows};
 pub use axes::AxisMask;
-pub use haptic::{HapticConfig, HapticFrame, HapticLoop};
+pub use god_object::{GodObject, ProxyContact, ProxySurface};
+pub use haptic::{HapticConfig, HapticContact, HapticFrame, HapticLoop};
 pub use hierarchy::NodeHierarchy;
 pub use local_loop::{Clock, LocalLoop, LocalLoopParams, LoopStats, SystemClock};
 pub use model::{MassSpringModel, Spring};
