@@ -217,7 +217,8 @@ fn quick_rheology_matches_the_closed_form_and_the_presets() {
 
 /// `incise experiment nakao-plate --quick`: the plate before the cut is the generated
 /// 24 × 24 × 1 Kuhn grid (25² × 2 nodes, 24² × 6 tets); the 4 cm cut adds nodes and
-/// tets, the non-adaptive split more of them and worse tets than the adaptive one; the
+/// tets, the non-adaptive split more of them and worse tets than the adaptive one, the
+/// Bielser-style split (quad centres) more still; the
 /// cut surface (both sides) is 2 × length × 4 mm thick, give or take the cells at its
 /// ends; the wound opens under 4 % tension and not without it.
 #[test]
@@ -239,6 +240,7 @@ fn quick_nakao_plate_cuts_the_plate_as_its_geometry_says() {
         ("adaptive", 0.0),
         ("adaptive", 0.04),
         ("non-adaptive", 0.04),
+        ("bielser", 0.04),
     ] {
         let r = case(sub, tension);
         let n: Vec<f64> = r[2..10].iter().map(|c| num(c)).collect();
@@ -270,6 +272,11 @@ fn quick_nakao_plate_cuts_the_plate_as_its_geometry_says() {
     let (a, na) = (case("adaptive", 0.04), case("non-adaptive", 0.04));
     let added = |r: &Vec<String>| num(&r[9]) - num(&r[8]);
     assert!(added(na) > added(a), "non-adaptive {na:?}, adaptive {a:?}");
+    let b = case("bielser", 0.04);
+    assert!(
+        added(b) > added(na),
+        "Bielser-style {b:?}, non-adaptive {na:?}"
+    );
     assert!(
         num(&na[14]) < num(&a[14]),
         "worst dihedral: {na:?} vs {a:?}"

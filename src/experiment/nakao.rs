@@ -1,5 +1,6 @@
 //! `incise experiment nakao-plate`: the plate experiment of Nakao et al. 2003 (PHYSICS.md
-//! §2.6) — the same straight cut at tension 0, 2, 4 and 6 %, adaptive and non-adaptive —
+//! §2.6) — the same straight cut at tension 0, 2, 4 and 6 %, adaptive, non-adaptive and
+//! Bielser-style —
 //! as a table (counts before/after, cut-surface area, wound opening, loop times), line
 //! charts and top-down images of the opened wounds.
 
@@ -40,14 +41,21 @@ pub struct NakaoOptions {
     pub quick: bool,
 }
 
-/// The runs' setups: every tension of the full experiment, adaptive and non-adaptive
-/// (non-adaptive not at 0 %), or the quick version's.
+/// The subdivisions compared: the paper's adaptive one and the two baselines.
+const SUBDIVISIONS: [Subdivision; 3] = [
+    Subdivision::Adaptive,
+    Subdivision::NonAdaptive,
+    Subdivision::Bielser,
+];
+
+/// The runs' setups: every tension of the full experiment, each subdivision (the baselines
+/// not at 0 %), or the quick version's.
 fn setups(quick: bool) -> Vec<PlateCutSetup> {
     let tensions: &[f64] = if quick { &QUICK_TENSIONS } else { &TENSIONS };
     let mut setups = Vec::new();
-    for sub in [Subdivision::Adaptive, Subdivision::NonAdaptive] {
+    for sub in SUBDIVISIONS {
         for &s in tensions {
-            if s == 0.0 && sub == Subdivision::NonAdaptive {
+            if s == 0.0 && sub != Subdivision::Adaptive {
                 continue;
             }
             let mut setup = PlateCutSetup::reference(s, sub);
@@ -131,6 +139,7 @@ fn label(sub: Subdivision) -> &'static str {
     match sub {
         Subdivision::Adaptive => "adaptive",
         Subdivision::NonAdaptive => "non-adaptive",
+        Subdivision::Bielser => "bielser",
     }
 }
 
@@ -224,11 +233,11 @@ fn series(runs: &[Run], sub: Subdivision, value: impl Fn(&PlateCutResult) -> f64
 }
 
 fn charts(out: &Path, runs: &[Run]) -> Result<()> {
-    let both = |value: &dyn Fn(&PlateCutResult) -> f64| {
-        vec![
-            series(runs, Subdivision::Adaptive, value),
-            series(runs, Subdivision::NonAdaptive, value),
-        ]
+    let all = |value: &dyn Fn(&PlateCutResult) -> f64| {
+        SUBDIVISIONS
+            .iter()
+            .map(|&sub| series(runs, sub, value))
+            .collect()
     };
     write_line_chart(
         &out.join("opening_vs_tension.png"),
@@ -236,7 +245,7 @@ fn charts(out: &Path, runs: &[Run]) -> Result<()> {
             title: "Wound opening at the middle of the cut (Nakao 2003 Fig. 11)".into(),
             x_label: "tension s (%)".into(),
             y_label: "opening width (mm)".into(),
-            series: both(&|r| r.opening_width * 1e3),
+            series: all(&|r| r.opening_width * 1e3),
         },
         800,
         500,
@@ -244,10 +253,10 @@ fn charts(out: &Path, runs: &[Run]) -> Result<()> {
     write_line_chart(
         &out.join("cut_area.png"),
         &LineChart {
-            title: "Total cut-surface area, adaptive vs non-adaptive (Fig. 12)".into(),
+            title: "Total cut-surface area, adaptive vs the baselines (Fig. 12)".into(),
             x_label: "tension s (%)".into(),
             y_label: "cut area (cm²)".into(),
-            series: both(&|r| r.cut_area * 1e4),
+            series: all(&|r| r.cut_area * 1e4),
         },
         800,
         500,
@@ -257,7 +266,7 @@ fn charts(out: &Path, runs: &[Run]) -> Result<()> {
 
 /// Top-down view of the top surface's springs in the middle of the plate, per run.
 fn wounds(out: &Path, runs: &[Run]) -> Result<()> {
-    for sub in [Subdivision::Adaptive, Subdivision::NonAdaptive] {
+    for sub in SUBDIVISIONS {
         let panels: Vec<SegmentPanel> = runs
             .iter()
             .filter(|r| r.result.setup.cut.subdivision == sub && r.result.setup.tension > 0.0)

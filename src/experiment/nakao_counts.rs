@@ -41,6 +41,7 @@ fn variants() -> Vec<(&'static str, PlateCutSetup)> {
         ("adaptive, snap 30 %", wide_snap),
         ("adaptive, no node moves", no_moves),
         ("non-adaptive", base(Subdivision::NonAdaptive)),
+        ("Bielser-style (quad centres)", base(Subdivision::Bielser)),
         ("adaptive, diagonal line", diagonal(Subdivision::Adaptive)),
         (
             "non-adaptive, diagonal line",

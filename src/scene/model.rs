@@ -171,7 +171,7 @@ pub struct MassSpringScene {
     /// A scripted blade stroke; absent: no cutting.
     #[serde(default)]
     pub stroke: Option<StrokeSpec>,
-    /// Cutter settings (`subdivision: Adaptive | NonAdaptive`, …).
+    /// Cutter settings (`subdivision: Adaptive | NonAdaptive | Bielser`, …).
     #[serde(default)]
     pub cut: CutParams,
     /// Which nodes each frame integrates: `Whole` (default), `Level(d)` around the blade,

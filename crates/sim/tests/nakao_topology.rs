@@ -97,7 +97,7 @@ proptest! {
         moving in any::<bool>(),
     ) {
         let Some(mesh) = mesh(cells, &jitter) else { return Ok(()); };
-        for sub in [Subdivision::Adaptive, Subdivision::NonAdaptive] {
+        for sub in [Subdivision::Adaptive, Subdivision::NonAdaptive, Subdivision::Bielser] {
             let mut m = model(&mesh, tension);
             let params = CutParams { subdivision: sub, ..CutParams::default() };
             let mut cutter = Cutter::new(params.clone());

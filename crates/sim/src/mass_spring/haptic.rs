@@ -51,7 +51,7 @@ impl Default for HapticConfig {
 
 /// The coupling of the tool point to the tissue, both a virtual spring of stiffness
 /// [`HapticConfig::coupling`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum HapticContact {
     /// To the node nearest the tip, within [`HapticConfig::contact_radius`]: pulls as well
     /// as pushes (a blade held in the cut), and the force steps when the nearest node

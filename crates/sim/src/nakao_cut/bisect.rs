@@ -9,6 +9,8 @@ use crate::mass_spring::{AxisMask, MassSpringModel};
 pub(crate) struct Bisection {
     /// Nodes created on the split edges, in split order.
     pub new_nodes: Vec<u32>,
+    /// The edge each of [`Bisection::new_nodes`] was created on.
+    pub parents: Vec<[u32; 2]>,
     /// Tets rewritten in place or appended.
     pub touched_tets: Vec<u32>,
 }
@@ -42,6 +44,7 @@ pub(crate) fn bisect_edges(
             inherited_axes(model, ai, bi),
         );
         out.new_nodes.push(q);
+        out.parents.push([a, b]);
         for tet in around {
             let parent = model.tets[tet as usize];
             let ia = parent.iter().position(|&v| v == a).unwrap_or(0);
@@ -67,6 +70,17 @@ pub(crate) fn bisect_edges(
     out.touched_tets.sort_unstable();
     out.touched_tets.dedup();
     out
+}
+
+impl Bisection {
+    /// Add what a later sequence of bisections changed.
+    pub fn absorb(&mut self, later: Bisection) {
+        self.new_nodes.extend(later.new_nodes);
+        self.parents.extend(later.parents);
+        self.touched_tets.extend(later.touched_tets);
+        self.touched_tets.sort_unstable();
+        self.touched_tets.dedup();
+    }
 }
 
 /// Axes held by a node created on edge `a`–`b`: all of them between two pinned nodes;

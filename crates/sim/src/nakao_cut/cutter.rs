@@ -2,7 +2,7 @@
 //! crossed edges, (adaptive) node displacement, minimal subdivision, remodelling (node
 //! duplication, spring removal, masses), (adaptive) rest-length update and smoothing.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::bisect::bisect_edges;
 use super::crossing::{candidate_tets, find_crossings, tolerances};
 use super::node_move::tets_quality;
+use super::quad_centre::centre_quads;
 use super::separate::separate;
 use super::smooth::smooth;
 use super::snap::{Moved, Snapper};
@@ -28,6 +29,10 @@ pub enum Subdivision {
     /// fixed order, nothing moved; a partially crossed tet is split only on the edges C has
     /// crossed so far.
     NonAdaptive,
+    /// The baseline after Bielser & Gross 2000 as Nakao 2003 counts it (3–5 new vertices,
+    /// 4–9 tets per cut tet): the non-adaptive split plus a centre vertex on every
+    /// quadrilateral cut face (`quad_centre.rs`; reconstructed from the counts).
+    Bielser,
 }
 
 /// Settings of the cutter.
@@ -130,6 +135,8 @@ pub struct Cutter {
     on_cut: HashSet<u32>,
     /// Regions swept so far in the current stroke.
     stroke: Vec<SweptRegion>,
+    /// Crossing nodes of the current stroke by the edge each split ([`Subdivision::Bielser`]).
+    crossing_parents: HashMap<u32, [u32; 2]>,
     margin: f64,
 }
 
@@ -141,6 +148,7 @@ impl Cutter {
             pose: None,
             on_cut: HashSet::new(),
             stroke: Vec::new(),
+            crossing_parents: HashMap::new(),
             margin: 0.0,
         }
     }
@@ -160,6 +168,7 @@ impl Cutter {
         self.pose = Some(pose);
         self.on_cut.clear();
         self.stroke.clear();
+        self.crossing_parents.clear();
         // A tet meeting C has a node within its longest edge of C.
         let x = model.positions();
         self.margin = 1.5
@@ -178,6 +187,7 @@ impl Cutter {
         self.pose = None;
         self.on_cut.clear();
         self.stroke.clear();
+        self.crossing_parents.clear();
     }
 
     /// Move the blade to `pose`, cutting what it sweeps from the previous pose. The first
@@ -275,7 +285,11 @@ impl Cutter {
                 on_cut.insert(v);
             }
         }
-        let bisection = bisect_edges(model, &cross.split, &plan.order);
+        let mut bisection = bisect_edges(model, &cross.split, &plan.order);
+        if p.subdivision == Subdivision::Bielser {
+            let centres = centre_quads(model, &bisection, &mut self.crossing_parents);
+            bisection.absorb(centres);
+        }
         on_cut.extend(&bisection.new_nodes);
         // Only the cut nodes near this advance can bound a face to open now.
         let mut local: Vec<u32> = cross

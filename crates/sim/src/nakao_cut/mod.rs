@@ -2,7 +2,8 @@
 //! the partial plane the blade sweeps between two poses, the edges it crosses, node
 //! displacement onto its boundary, minimal subdivision (4 or 6 tets per crossed tet, the
 //! split chosen by dihedral angles), remodelling by node duplication, and smoothing; plus
-//! the non-adaptive baseline for comparison.
+//! the non-adaptive baselines for comparison (fixed-order minimal, and after Bielser &
+//! Gross 2000 with quadrilateral centres).
 
 mod bisect;
 mod blade;
@@ -14,6 +15,7 @@ pub mod invariants;
 pub mod measure;
 mod node_move;
 mod plate_experiment;
+mod quad_centre;
 mod separate;
 mod smooth;
 mod snap;
