@@ -20,7 +20,7 @@ pub struct RealtimeResult {
     pub scene: String,
     /// "cpu (N threads)" or the GPU adapter.
     pub device: String,
-    /// The CPU projection kernel ("Lanes" or "Scalar"; the GPU ignores it).
+    /// The CPU projection kernel ("Lanes", "PortableLanes" or "Scalar"; the GPU ignores it).
     pub cpu_kernel: String,
     /// Tets.
     pub tets: usize,
@@ -53,7 +53,7 @@ pub type CpuChoice = (Option<usize>, Option<CpuKernel>);
 pub const MARKDOWN_RUNS: usize = 3;
 
 /// Time `frames` frames of `scene` on `device` and print a table row, the JSON, or (with
-/// `Markdown`) both CPU kernels interleaved, [`MARKDOWN_RUNS`] runs each, as the
+/// `Markdown`) the three CPU kernels interleaved, [`MARKDOWN_RUNS`] runs each, as the
 /// markdown table of docs/performance.md under its provenance line.
 pub fn run(
     scene: &Path,
@@ -66,7 +66,11 @@ pub fn run(
     if output == BenchOutput::Markdown {
         let kernels = match cpu.1 {
             Some(k) => vec![k],
-            None => vec![CpuKernel::Scalar, CpuKernel::Lanes],
+            None => vec![
+                CpuKernel::Scalar,
+                CpuKernel::PortableLanes,
+                CpuKernel::Lanes,
+            ],
         };
         let mut runs: Vec<Vec<RealtimeResult>> = vec![Vec::new(); kernels.len()];
         for _ in 0..MARKDOWN_RUNS {

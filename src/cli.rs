@@ -403,8 +403,10 @@ pub enum GenKind {
 /// Which CPU kernel projects the tets (`incise bench realtime --cpu-kernel`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum KernelChoice {
-    /// Eight tets at once in SIMD lanes (the default).
+    /// Eight tets at once in SIMD lanes, AVX2 where the CPU has it (the default).
     Lanes,
+    /// The same lanes at the build's own instruction set (no AVX2 detection).
+    PortableLanes,
     /// One tet at a time (the reference).
     Scalar,
 }
@@ -413,6 +415,7 @@ impl From<KernelChoice> for incise_sim::xpbd::CpuKernel {
     fn from(k: KernelChoice) -> Self {
         match k {
             KernelChoice::Lanes => incise_sim::xpbd::CpuKernel::Lanes,
+            KernelChoice::PortableLanes => incise_sim::xpbd::CpuKernel::PortableLanes,
             KernelChoice::Scalar => incise_sim::xpbd::CpuKernel::Scalar,
         }
     }

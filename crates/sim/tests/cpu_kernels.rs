@@ -65,12 +65,26 @@ fn pull(
     )
 }
 
+/// Both lane kernels — `Lanes` (AVX registers where the CPU has AVX2, picked at run time)
+/// and `PortableLanes` (the build's own instruction set) — against the scalar reference.
 #[test]
 fn lanes_match_the_scalar_kernel_under_load_and_tearing() {
+    #[cfg(target_arch = "x86_64")]
+    eprintln!("AVX2: {}", std::arch::is_x86_feature_detected!("avx2"));
     // ν = 0: no volume constraint (the lanes' other branch); a softer tissue, a lower threshold.
-    for (threads, nu, threshold) in [(1, 0.45, 5e3), (2, 0.3, 5e3), (1, 0.0, 3e3)] {
+    let cases = [(1, 0.45, 5e3), (2, 0.3, 5e3), (1, 0.0, 3e3)];
+    for kernel in [CpuKernel::Lanes, CpuKernel::PortableLanes] {
+        for (threads, nu, threshold) in cases {
+            compare(kernel, threads, nu, threshold);
+        }
+    }
+}
+
+/// `kernel`'s pull against the scalar kernel's: positions, stresses and released tets.
+fn compare(kernel: CpuKernel, threads: usize, nu: f32, threshold: f32) {
+    {
         let (x_ref, vm_ref, cut_ref, peak) = pull(CpuKernel::Scalar, threads, nu, threshold);
-        let (x, vm, cut, _) = pull(CpuKernel::Lanes, threads, nu, threshold);
+        let (x, vm, cut, _) = pull(kernel, threads, nu, threshold);
         let dx = x
             .iter()
             .zip(&x_ref)
@@ -82,7 +96,7 @@ fn lanes_match_the_scalar_kernel_under_load_and_tearing() {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f32::max);
         println!(
-            "threads {threads}, ν {nu}: max |Δx| {dx:.2e} m, max |ΔσvM| {dvm:.1} Pa of {peak:.0}, released {cut} vs {cut_ref}"
+            "{kernel:?}, threads {threads}, ν {nu}: max |Δx| {dx:.2e} m, max |ΔσvM| {dvm:.1} Pa of {peak:.0}, released {cut} vs {cut_ref}"
         );
         assert!(
             peak > threshold,

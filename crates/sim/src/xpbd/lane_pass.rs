@@ -3,7 +3,7 @@
 
 use glam::{Mat3, Vec3};
 
-use super::lanes::{L, LANES, M3, V3};
+use super::lanes::{LANES, Lane, M3, V3};
 use super::rest_free_lanes::{TetLanes, project_rest_free_lanes};
 use super::shared_nodes::SharedNodes;
 use super::solver::TetSlot;
@@ -13,8 +13,8 @@ use super::solver::TetSlot;
 ///
 /// # Safety
 /// No other thread may touch these tets' nodes during the call (colouring).
-#[inline]
-pub(super) unsafe fn project_block(
+#[inline(always)]
+unsafe fn project_block<L: Lane>(
     slots: &[TetSlot],
     lambdas: &mut [f32],
     nodes: &SharedNodes,
@@ -37,8 +37,15 @@ pub(super) unsafe fn project_block(
         live[k] = f32::from_bits(u32::MAX);
     }
     let mut lanes = TetLanes {
-        u: u.map(|n| V3::gather(&n)),
-        w: w.map(L::new),
+        // Written out, not `map`: an out-of-line `map` would be compiled without the
+        // caller's AVX and call each intrinsic.
+        u: [
+            V3::gather(&u[0]),
+            V3::gather(&u[1]),
+            V3::gather(&u[2]),
+            V3::gather(&u[3]),
+        ],
+        w: [L::new(w[0]), L::new(w[1]), L::new(w[2]), L::new(w[3])],
         dm_inv: M3::gather(&dm_inv),
         alpha_h: L::new(alpha_h),
         alpha_d: L::new(alpha_d),
@@ -54,7 +61,9 @@ pub(super) unsafe fn project_block(
     }
 }
 
-/// Project a run of one colour's slots, block by block.
+/// Project a run of one colour's slots, block by block: in one AVX register per lane
+/// value where `detect` is set and the CPU has AVX2 (checked at run time, so a portable
+/// build uses it too), else with `wide`'s lanes at the build's instruction set.
 ///
 /// # Safety
 /// As [`project_block`].
@@ -63,9 +72,47 @@ pub(super) unsafe fn project_run(
     lambdas: &mut [f32],
     nodes: &SharedNodes,
     inv_mass: &[f32],
+    detect: bool,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if detect && std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2; the rest is the caller's contract.
+        return unsafe { project_run_avx2(slots, lambdas, nodes, inv_mass) };
+    }
+    let _ = detect;
+    // SAFETY: the caller's contract.
+    unsafe { project_blocks::<wide::f32x8>(slots, lambdas, nodes, inv_mass) }
+}
+
+/// [`project_blocks`] with [`super::lane_avx::Avx`] lanes, compiled for AVX2.
+///
+/// # Safety
+/// The CPU must have AVX2; otherwise as [`project_block`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn project_run_avx2(
+    slots: &[TetSlot],
+    lambdas: &mut [f32],
+    nodes: &SharedNodes,
+    inv_mass: &[f32],
+) {
+    // SAFETY: the caller's contract.
+    unsafe { project_blocks::<super::lane_avx::Avx>(slots, lambdas, nodes, inv_mass) }
+}
+
+/// The run, block by block, compiled into its caller.
+///
+/// # Safety
+/// As [`project_block`].
+#[inline(always)]
+unsafe fn project_blocks<L: Lane>(
+    slots: &[TetSlot],
+    lambdas: &mut [f32],
+    nodes: &SharedNodes,
+    inv_mass: &[f32],
 ) {
     for (s, l) in slots.chunks(LANES).zip(lambdas.chunks_mut(LANES)) {
         // SAFETY: the caller's contract.
-        unsafe { project_block(s, l, nodes, inv_mass) };
+        unsafe { project_block::<L>(s, l, nodes, inv_mass) };
     }
 }

@@ -1,21 +1,15 @@
-//! Eight-lane 3-vectors and 3×3 matrices (`wide::f32x8`): the algebra of the batched tet
+//! Eight-lane 3-vectors and 3×3 matrices over a [`Lane`] type: the algebra of the batched tet
 //! projection ([`super::rest_free_lanes`]), each lane one tet. The operations mirror
 //! glam's `Vec3`/`Mat3` (column-major, the same operation order) so that a lane computes
 //! what the scalar reference computes, up to the rounding of `ln`.
 
 use std::ops::{Add, Mul, Neg, Sub};
 
-use wide::f32x8;
-
-/// Number of tets projected together.
-pub const LANES: usize = 8;
-
-/// One `f32` per lane.
-pub type L = f32x8;
+pub use super::lane::{LANES, Lane};
 
 /// A 3-vector per lane.
 #[derive(Debug, Clone, Copy)]
-pub struct V3 {
+pub struct V3<L> {
     /// x components.
     pub x: L,
     /// y components.
@@ -24,49 +18,49 @@ pub struct V3 {
     pub z: L,
 }
 
-impl V3 {
+impl<L: Lane> V3<L> {
     /// The zero vector in every lane.
-    pub const ZERO: V3 = V3 {
+    pub const ZERO: V3<L> = V3 {
         x: L::ZERO,
         y: L::ZERO,
         z: L::ZERO,
     };
 
     /// Lane `k` of `v` is `v[k]`.
-    #[inline]
-    pub fn gather(v: &[glam::Vec3; LANES]) -> V3 {
+    #[inline(always)]
+    pub fn gather(v: &[glam::Vec3; LANES]) -> V3<L> {
         V3 {
-            x: L::new(v.map(|p| p.x)),
-            y: L::new(v.map(|p| p.y)),
-            z: L::new(v.map(|p| p.z)),
+            x: L::new(std::array::from_fn(|k| v[k].x)),
+            y: L::new(std::array::from_fn(|k| v[k].y)),
+            z: L::new(std::array::from_fn(|k| v[k].z)),
         }
     }
 
     /// The vector of lane `k`.
-    #[inline]
+    #[inline(always)]
     pub fn lane(&self, k: usize) -> glam::Vec3 {
         glam::Vec3::new(
-            self.x.as_array()[k],
-            self.y.as_array()[k],
-            self.z.as_array()[k],
+            self.x.to_array()[k],
+            self.y.to_array()[k],
+            self.z.to_array()[k],
         )
     }
 
     /// Dot product per lane.
-    #[inline]
-    pub fn dot(self, o: V3) -> L {
+    #[inline(always)]
+    pub fn dot(self, o: V3<L>) -> L {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     /// Squared length per lane.
-    #[inline]
+    #[inline(always)]
     pub fn length_squared(self) -> L {
         self.dot(self)
     }
 
     /// Cross product per lane.
-    #[inline]
-    pub fn cross(self, o: V3) -> V3 {
+    #[inline(always)]
+    pub fn cross(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.y * o.z - o.y * self.z,
             y: self.z * o.x - o.z * self.x,
@@ -75,10 +69,10 @@ impl V3 {
     }
 }
 
-impl Add for V3 {
-    type Output = V3;
-    #[inline]
-    fn add(self, o: V3) -> V3 {
+impl<L: Lane> Add for V3<L> {
+    type Output = V3<L>;
+    #[inline(always)]
+    fn add(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x + o.x,
             y: self.y + o.y,
@@ -87,10 +81,10 @@ impl Add for V3 {
     }
 }
 
-impl Sub for V3 {
-    type Output = V3;
-    #[inline]
-    fn sub(self, o: V3) -> V3 {
+impl<L: Lane> Sub for V3<L> {
+    type Output = V3<L>;
+    #[inline(always)]
+    fn sub(self, o: V3<L>) -> V3<L> {
         V3 {
             x: self.x - o.x,
             y: self.y - o.y,
@@ -99,10 +93,10 @@ impl Sub for V3 {
     }
 }
 
-impl Neg for V3 {
-    type Output = V3;
-    #[inline]
-    fn neg(self) -> V3 {
+impl<L: Lane> Neg for V3<L> {
+    type Output = V3<L>;
+    #[inline(always)]
+    fn neg(self) -> V3<L> {
         V3 {
             x: -self.x,
             y: -self.y,
@@ -111,10 +105,10 @@ impl Neg for V3 {
     }
 }
 
-impl Mul<L> for V3 {
-    type Output = V3;
-    #[inline]
-    fn mul(self, s: L) -> V3 {
+impl<L: Lane> Mul<L> for V3<L> {
+    type Output = V3<L>;
+    #[inline(always)]
+    fn mul(self, s: L) -> V3<L> {
         V3 {
             x: self.x * s,
             y: self.y * s,
@@ -125,19 +119,19 @@ impl Mul<L> for V3 {
 
 /// A 3×3 matrix per lane, by columns.
 #[derive(Debug, Clone, Copy)]
-pub struct M3 {
+pub struct M3<L> {
     /// First column.
-    pub c0: V3,
+    pub c0: V3<L>,
     /// Second column.
-    pub c1: V3,
+    pub c1: V3<L>,
     /// Third column.
-    pub c2: V3,
+    pub c2: V3<L>,
 }
 
-impl M3 {
+impl<L: Lane> M3<L> {
     /// `s · I` per lane.
-    #[inline]
-    pub fn diagonal(s: L) -> M3 {
+    #[inline(always)]
+    pub fn diagonal(s: L) -> M3<L> {
         let z = L::ZERO;
         M3 {
             c0: V3 { x: s, y: z, z },
@@ -147,8 +141,8 @@ impl M3 {
     }
 
     /// Lane `k` of the result is `m[k]`.
-    #[inline]
-    pub fn gather(m: &[glam::Mat3; LANES]) -> M3 {
+    #[inline(always)]
+    pub fn gather(m: &[glam::Mat3; LANES]) -> M3<L> {
         M3 {
             c0: V3::gather(&m.map(|a| a.x_axis)),
             c1: V3::gather(&m.map(|a| a.y_axis)),
@@ -157,9 +151,9 @@ impl M3 {
     }
 
     /// Row `r` as a vector.
-    #[inline]
-    fn row(&self, r: usize) -> V3 {
-        let pick = |c: &V3| match r {
+    #[inline(always)]
+    fn row(&self, r: usize) -> V3<L> {
+        let pick = |c: &V3<L>| match r {
             0 => c.x,
             1 => c.y,
             _ => c.z,
@@ -172,8 +166,8 @@ impl M3 {
     }
 
     /// Transpose per lane.
-    #[inline]
-    pub fn transpose(&self) -> M3 {
+    #[inline(always)]
+    pub fn transpose(&self) -> M3<L> {
         M3 {
             c0: self.row(0),
             c1: self.row(1),
@@ -182,14 +176,14 @@ impl M3 {
     }
 
     /// Matrix × vector per lane.
-    #[inline]
-    pub fn mul_vec(&self, v: V3) -> V3 {
+    #[inline(always)]
+    pub fn mul_vec(&self, v: V3<L>) -> V3<L> {
         self.c0 * v.x + self.c1 * v.y + self.c2 * v.z
     }
 
     /// Matrix product per lane.
-    #[inline]
-    pub fn mul_mat(&self, o: &M3) -> M3 {
+    #[inline(always)]
+    pub fn mul_mat(&self, o: &M3<L>) -> M3<L> {
         M3 {
             c0: self.mul_vec(o.c0),
             c1: self.mul_vec(o.c1),
@@ -198,14 +192,14 @@ impl M3 {
     }
 
     /// Determinant per lane (glam's order: `c2 · (c0 × c1)`).
-    #[inline]
+    #[inline(always)]
     pub fn determinant(&self) -> L {
         self.c2.dot(self.c0.cross(self.c1))
     }
 
     /// Cofactor matrix `[c1×c2, c2×c0, c0×c1]` per lane.
-    #[inline]
-    pub fn cofactor(&self) -> M3 {
+    #[inline(always)]
+    pub fn cofactor(&self) -> M3<L> {
         M3 {
             c0: self.c1.cross(self.c2),
             c1: self.c2.cross(self.c0),
@@ -214,22 +208,22 @@ impl M3 {
     }
 
     /// Trace per lane.
-    #[inline]
+    #[inline(always)]
     pub fn trace(&self) -> L {
         self.c0.x + self.c1.y + self.c2.z
     }
 
     /// Squared Frobenius norm per lane.
-    #[inline]
+    #[inline(always)]
     pub fn norm2(&self) -> L {
         self.c0.length_squared() + self.c1.length_squared() + self.c2.length_squared()
     }
 }
 
-impl Add for M3 {
-    type Output = M3;
-    #[inline]
-    fn add(self, o: M3) -> M3 {
+impl<L: Lane> Add for M3<L> {
+    type Output = M3<L>;
+    #[inline(always)]
+    fn add(self, o: M3<L>) -> M3<L> {
         M3 {
             c0: self.c0 + o.c0,
             c1: self.c1 + o.c1,
@@ -238,10 +232,10 @@ impl Add for M3 {
     }
 }
 
-impl Sub for M3 {
-    type Output = M3;
-    #[inline]
-    fn sub(self, o: M3) -> M3 {
+impl<L: Lane> Sub for M3<L> {
+    type Output = M3<L>;
+    #[inline(always)]
+    fn sub(self, o: M3<L>) -> M3<L> {
         M3 {
             c0: self.c0 - o.c0,
             c1: self.c1 - o.c1,
@@ -250,10 +244,10 @@ impl Sub for M3 {
     }
 }
 
-impl Mul<L> for M3 {
-    type Output = M3;
-    #[inline]
-    fn mul(self, s: L) -> M3 {
+impl<L: Lane> Mul<L> for M3<L> {
+    type Output = M3<L>;
+    #[inline(always)]
+    fn mul(self, s: L) -> M3<L> {
         M3 {
             c0: self.c0 * s,
             c1: self.c1 * s,
@@ -265,6 +259,10 @@ impl Mul<L> for M3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use wide::f32x8;
+
+    type V3 = super::V3<f32x8>;
+    type M3 = super::M3<f32x8>;
     use glam::{Mat3, Vec3};
 
     fn sample(k: usize) -> Mat3 {

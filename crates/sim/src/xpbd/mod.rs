@@ -2,6 +2,9 @@
 
 mod coloring;
 mod frame;
+mod lane;
+#[cfg(target_arch = "x86_64")]
+mod lane_avx;
 mod lane_pass;
 mod lanes;
 mod neo_hookean;

@@ -15,9 +15,13 @@ pub const DEFAULT_RELEASE_INTERVAL: f32 = 1.0 / 240.0;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum CpuKernel {
     /// Eight tets of a colour at once in SIMD lanes, for the rest-free coupled pair (the
-    /// other pairs and modes run scalar); matches `Scalar` to rounding (tested).
+    /// other pairs and modes run scalar), in AVX registers where the CPU has AVX2 (detected
+    /// at run time); matches `Scalar` to rounding (tested).
     #[default]
     Lanes,
+    /// The same lanes at the build's own instruction set, no run-time detection (SSE2 in
+    /// the portable x86-64 build): for measuring what AVX2 buys.
+    PortableLanes,
     /// One tet at a time: the reference the lanes and the GPU are tested against.
     Scalar,
 }

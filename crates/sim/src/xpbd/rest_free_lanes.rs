@@ -4,20 +4,20 @@
 //! branch of the reference evaluated in every lane and chosen by a mask. Tets of one colour
 //! share no node, so eight of them are independent (PHYSICS.md §1.2, parallel form).
 
-use super::lanes::{L, M3, V3};
+use super::lanes::{Lane, M3, V3};
 use super::rest_free::{J_MIN, MIN_SHAPE};
 use super::strain::SERIES_LIMIT;
 
 /// Eight tets' inputs (padding lanes: zero displacement and weight, `Dm⁻¹ = I`, unit
 /// compliances, not live).
 #[derive(Debug, Clone, Copy)]
-pub struct TetLanes {
+pub struct TetLanes<L> {
     /// The four nodes' displacements from rest; projected in place.
-    pub u: [V3; 4],
+    pub u: [V3<L>; 4],
     /// The four nodes' inverse masses.
     pub w: [L; 4],
     /// Inverse rest shape matrices `Dm⁻¹`.
-    pub dm_inv: M3,
+    pub dm_inv: M3<L>,
     /// `α̃_H = 1/(λ V h²)` (infinite at λ = 0: no volume constraint).
     pub alpha_h: L,
     /// `α̃_D = 1/(μ V h²)`.
@@ -28,8 +28,8 @@ pub struct TetLanes {
 
 /// `x − ln(1 + x)`: the series below [`SERIES_LIMIT`], else direct (strain.rs
 /// `log1p_excess`).
-#[inline]
-fn log1p_excess(x: L) -> L {
+#[inline(always)]
+fn log1p_excess<L: Lane>(x: L) -> L {
     let s = L::splat;
     let x2 = x * x;
     let tail = s(-1.0 / 7.0) + x * s(0.125);
@@ -40,18 +40,18 @@ fn log1p_excess(x: L) -> L {
 }
 
 /// The invariants of `F = I + H` from `H` (strain.rs `Strain`).
-struct StrainLanes {
-    h: M3,
+struct StrainLanes<L> {
+    h: M3<L>,
     tr: L,
     i2: L,
     det_h: L,
     j1: L,
-    cof_h: M3,
+    cof_h: M3<L>,
 }
 
-impl StrainLanes {
-    #[inline]
-    fn of(h: M3) -> Self {
+impl<L: Lane> StrainLanes<L> {
+    #[inline(always)]
+    fn of(h: M3<L>) -> Self {
         let tr = h.trace();
         let tr_h2 = h.mul_mat(&h).trace();
         let i2 = L::splat(0.5) * (tr * tr - tr_h2);
@@ -67,14 +67,14 @@ impl StrainLanes {
     }
 
     /// `cof F = (1 + tr H) I − Hᵀ + cof H`.
-    #[inline]
-    fn cof_f(&self) -> M3 {
+    #[inline(always)]
+    fn cof_f(&self) -> M3<L> {
         M3::diagonal(L::ONE + self.tr) - self.h.transpose() + self.cof_h
     }
 
     /// `J F − cof F = (I₂ + det H) I + H + Hᵀ + (J − 1) H − cof H`.
-    #[inline]
-    fn j_f_minus_cof(&self) -> M3 {
+    #[inline(always)]
+    fn j_f_minus_cof(&self) -> M3<L> {
         M3::diagonal(self.i2 + self.det_h) + self.h + self.h.transpose() + self.h * self.j1
             - self.cof_h
     }
@@ -83,8 +83,8 @@ impl StrainLanes {
 /// `L(J)`, `L'(J)` and whether `J > J_MIN` (rest_free.rs `log_volume`), given
 /// `excess = log1p_excess(J − 1)`.
 // docs/physics-notes.md, rest-free pair, C_H.
-#[inline]
-fn log_volume(s: &StrainLanes, excess: L) -> (L, L, L) {
+#[inline(always)]
+fn log_volume<L: Lane>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
     let j = L::ONE + s.j1;
     let above = j.simd_gt(L::splat(J_MIN));
     let l = above.select(
@@ -98,8 +98,13 @@ fn log_volume(s: &StrainLanes, excess: L) -> (L, L, L) {
 /// `C_D = sqrt(ψ̂)`, `∂C_D/∂F`, and the lanes where `C_D` has a direction
 /// (rest_free.rs `shape_energy`, `shape_constraint`), given `log_volume` and the excess.
 // docs/physics-notes.md, rest-free pair, C_D.
-#[inline]
-fn shape_constraint(s: &StrainLanes, volume: (L, L, L), excess: L, cof_f: &M3) -> (L, M3, L) {
+#[inline(always)]
+fn shape_constraint<L: Lane>(
+    s: &StrainLanes<L>,
+    volume: (L, L, L),
+    excess: L,
+    cof_f: &M3<L>,
+) -> (L, M3<L>, L) {
     let (l, dl, above) = volume;
     let two = L::splat(2.0);
     let h_norm2 = s.h.norm2();
@@ -115,8 +120,8 @@ fn shape_constraint(s: &StrainLanes, volume: (L, L, L), excess: L, cof_f: &M3) -
     (c, half * (L::ONE / c), has)
 }
 
-#[inline]
-fn select_v3(m: L, a: V3, b: V3) -> V3 {
+#[inline(always)]
+fn select_v3<L: Lane>(m: L, a: V3<L>, b: V3<L>) -> V3<L> {
     V3 {
         x: m.select(a.x, b.x),
         y: m.select(a.y, b.y),
@@ -124,8 +129,8 @@ fn select_v3(m: L, a: V3, b: V3) -> V3 {
     }
 }
 
-#[inline]
-fn select_m3(m: L, a: &M3, b: &M3) -> M3 {
+#[inline(always)]
+fn select_m3<L: Lane>(m: L, a: &M3<L>, b: &M3<L>) -> M3<L> {
     M3 {
         c0: select_v3(m, a.c0, b.c0),
         c1: select_v3(m, a.c1, b.c1),
@@ -135,23 +140,29 @@ fn select_m3(m: L, a: &M3, b: &M3) -> M3 {
 
 /// `G = (∂C/∂F) Dm⁻ᵀ`: `∇x1..3` = columns of G, `∇x0 = −(∇x1+∇x2+∇x3)`.
 // PHYSICS.md §1.2, vertex gradients.
-#[inline]
-fn vertex_gradients(dcdf: &M3, dm_inv_t: &M3) -> [V3; 4] {
+#[inline(always)]
+fn vertex_gradients<L: Lane>(dcdf: &M3<L>, dm_inv_t: &M3<L>) -> [V3<L>; 4] {
     let g = dcdf.mul_mat(dm_inv_t);
     [-(g.c0 + g.c1 + g.c2), g.c0, g.c1, g.c2]
 }
 
-#[inline]
-fn weighted_dot(w: &[L; 4], a: &[V3; 4], b: &[V3; 4]) -> L {
+#[inline(always)]
+fn weighted_dot<L: Lane>(w: &[L; 4], a: &[V3<L>; 4], b: &[V3<L>; 4]) -> L {
     w[0] * a[0].dot(b[0]) + w[1] * a[1].dot(b[1]) + w[2] * a[2].dot(b[2]) + w[3] * a[3].dot(b[3])
 }
 
 /// One row of the 2×2 system, or an empty row (zero gradient and value, unit compliance)
 /// where its constraint does not apply.
-#[inline]
-fn row(on: L, g: [V3; 4], c: L, alpha: L) -> ([V3; 4], L, L) {
+#[inline(always)]
+fn row<L: Lane>(on: L, g: [V3<L>; 4], c: L, alpha: L) -> ([V3<L>; 4], L, L) {
     (
-        g.map(|v| select_v3(on, v, V3::ZERO)),
+        // Written out, not `map` (see lane_pass.rs).
+        [
+            select_v3(on, g[0], V3::ZERO),
+            select_v3(on, g[1], V3::ZERO),
+            select_v3(on, g[2], V3::ZERO),
+            select_v3(on, g[3], V3::ZERO),
+        ],
         on.select(c, L::ZERO),
         on.select(alpha, L::ONE),
     )
@@ -161,8 +172,8 @@ fn row(on: L, g: [V3; 4], c: L, alpha: L) -> ([V3; 4], L, L) {
 /// of this substep (0 where there is no volume constraint or no live tet).
 // PHYSICS.md §1.2, XPBD update (block form, λ = 0 at the start of the substep);
 // docs/physics-notes.md, rest-free pair.
-#[inline]
-pub fn project_rest_free_lanes(t: &mut TetLanes) -> L {
+#[inline(always)]
+pub fn project_rest_free_lanes<L: Lane>(t: &mut TetLanes<L>) -> L {
     let du = M3 {
         c0: t.u[1] - t.u[0],
         c1: t.u[2] - t.u[0],
@@ -248,9 +259,18 @@ mod tests {
 
     /// Lane k projects what the scalar reference projects for tet k, in every branch
     /// (rest, small and large strain, J below J_MIN, inverted, no volume constraint),
-    /// and a lane that is not live stays put.
+    /// and a lane that is not live stays put: with the portable lanes, and with the AVX
+    /// ones where the CPU has AVX2.
     #[test]
     fn lanes_match_the_scalar_reference() {
+        check::<wide::f32x8>();
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            check::<crate::xpbd::lane_avx::Avx>();
+        }
+    }
+
+    fn check<L: Lane>() {
         for alpha_h in [0.2f32, f32::INFINITY] {
             let w = |k: usize| [1.0, 0.5 + 0.1 * k as f32, 2.0, 0.0];
             let u: [[Vec3; 4]; LANES] = std::array::from_fn(displacements);

@@ -574,17 +574,17 @@ impl Solver {
         };
         let slots = &self.slots[range.clone()];
         let lambdas = &mut self.lambda_h[range];
-        let lanes = self.params.cpu_kernel == CpuKernel::Lanes
-            && pair == ConstraintPair::RestFree
-            && mode == TetProjection::Coupled;
+        let lanes = match self.params.cpu_kernel {
+            CpuKernel::Lanes => Some(true),
+            CpuKernel::PortableLanes => Some(false),
+            CpuKernel::Scalar => None,
+        }
+        .filter(|_| pair == ConstraintPair::RestFree && mode == TetProjection::Coupled);
         // One run of consecutive slots: eight at a time in SIMD lanes, else one by one.
-        let run = |(s, l): (&[TetSlot], &mut [f32])| {
-            if lanes {
-                // SAFETY: tets of one colour share no node, and each run is one task's.
-                unsafe { lane_pass::project_run(s, l, &nodes, inv_mass) }
-            } else {
-                s.iter().zip(l).for_each(|(s, l)| work(s, l));
-            }
+        let run = |(s, l): (&[TetSlot], &mut [f32])| match lanes {
+            // SAFETY: tets of one colour share no node, and each run is one task's.
+            Some(detect) => unsafe { lane_pass::project_run(s, l, &nodes, inv_mass, detect) },
+            None => s.iter().zip(l).for_each(|(s, l)| work(s, l)),
         };
         if parallel && slots.len() > CHUNK {
             slots

@@ -1,0 +1,106 @@
+//! What one lane type of the batched tet projection provides: eight `f32` (one tet each)
+//! with arithmetic, masks (all bits set or clear, as comparisons return) and the few
+//! functions the rest-free pair needs. Two types implement it: `wide::f32x8`, whose
+//! instructions are fixed when the crate is compiled (two SSE registers in the portable
+//! build), and [`super::lane_avx::Avx`], one AVX register, used only inside the function
+//! compiled for AVX2 that [`super::lane_pass`] picks at run time.
+
+use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
+
+use wide::f32x8;
+
+/// Number of tets projected together.
+pub const LANES: usize = 8;
+
+/// Eight `f32` lanes.
+pub trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + BitAnd<Output = Self>
+{
+    /// 0.0 in every lane.
+    const ZERO: Self;
+    /// 1.0 in every lane.
+    const ONE: Self;
+    /// Lane `k` is `v[k]`.
+    fn new(v: [f32; LANES]) -> Self;
+    /// `v` in every lane.
+    fn splat(v: f32) -> Self;
+    /// The lanes.
+    fn to_array(self) -> [f32; LANES];
+    /// Mask of the lanes where `self < o`.
+    fn simd_lt(self, o: Self) -> Self;
+    /// Mask of the lanes where `self > o`.
+    fn simd_gt(self, o: Self) -> Self;
+    /// Mask of the lanes where `self >= o`.
+    fn simd_ge(self, o: Self) -> Self;
+    /// With `self` a mask: `t` in its set lanes, `f` in the others.
+    fn select(self, t: Self, f: Self) -> Self;
+    /// Mask of the finite lanes.
+    fn is_finite(self) -> Self;
+    /// `|x|` per lane.
+    fn abs(self) -> Self;
+    /// `√x` per lane.
+    fn sqrt(self) -> Self;
+    /// The larger per lane.
+    fn max(self, o: Self) -> Self;
+    /// Natural logarithm per lane (finite `x > 0`).
+    fn ln(self) -> Self;
+}
+
+impl Lane for f32x8 {
+    const ZERO: Self = f32x8::ZERO;
+    const ONE: Self = f32x8::ONE;
+    #[inline(always)]
+    fn new(v: [f32; LANES]) -> Self {
+        f32x8::new(v)
+    }
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        f32x8::splat(v)
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; LANES] {
+        f32x8::to_array(self)
+    }
+    #[inline(always)]
+    fn simd_lt(self, o: Self) -> Self {
+        f32x8::simd_lt(self, o)
+    }
+    #[inline(always)]
+    fn simd_gt(self, o: Self) -> Self {
+        f32x8::simd_gt(self, o)
+    }
+    #[inline(always)]
+    fn simd_ge(self, o: Self) -> Self {
+        f32x8::simd_ge(self, o)
+    }
+    #[inline(always)]
+    fn select(self, t: Self, f: Self) -> Self {
+        wide::Select::select(self, t, f)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> Self {
+        f32x8::is_finite(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32x8::abs(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32x8::sqrt(self)
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        f32x8::max(self, o)
+    }
+    #[inline(always)]
+    fn ln(self) -> Self {
+        f32x8::ln(self)
+    }
+}
