@@ -26,8 +26,8 @@ use winit::event::{ElementState, MouseButton, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Fullscreen, Window, WindowId};
 
-use crate::body::{Body, DeviceChoice};
-use crate::screenshots::{ImageSize, Screenshots, default_camera, stress_scale};
+use crate::pictures::screenshots::{ImageSize, Screenshots, default_camera, stress_scale};
+use crate::sim_body::{Body, DeviceChoice};
 
 /// The preview's start view: the default one, a little farther out (the panel takes room).
 fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
@@ -225,7 +225,7 @@ impl Live {
         let device = match opts.device {
             // A software adapter runs the CPU solver faster than its own compute.
             DeviceChoice::Auto => {
-                let (pick, why) = crate::body::auto_device(&gpu.dev.info);
+                let (pick, why) = crate::sim_body::auto_device(&gpu.dev.info);
                 eprintln!("note: {why}");
                 pick
             }
@@ -253,7 +253,7 @@ impl Live {
             session.body.solver().mesh(),
             &session.skin,
         );
-        renderer.set_tool_mesh(&crate::tool_view::tool_mesh(&session.hand.tool));
+        renderer.set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&session.hand.tool));
         let egui = egui::Context::default();
         let egui_winit = egui_winit::State::new(
             egui.clone(),
@@ -409,7 +409,7 @@ impl Live {
         let settings = RenderSettings {
             overlays: self.panel.overlays,
             stress_max: stress_scale(solver),
-            tool: crate::tool_view::tool_state(solver),
+            tool: crate::pictures::tool_view::tool_state(solver),
             lines: self
                 .exercise
                 .iter()
@@ -496,7 +496,7 @@ impl Live {
             &s.skin,
         );
         self.renderer
-            .set_tool_mesh(&crate::tool_view::tool_mesh(&s.hand.tool));
+            .set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&s.hand.tool));
         self.home = preview_camera(s.body.solver().mesh());
         self.camera = self.home;
         self.panel.draft = s.params;
@@ -673,8 +673,8 @@ impl Live {
         let dir = PathBuf::from("out/preview");
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         let solver = self.session.body.solver();
-        let mut pvd = Vec::new();
-        crate::run::snapshot(&dir, solver, solver.frame(), &mut pvd)?;
-        Ok(format!("saved {}", dir.join(&pvd[0].1).display()))
+        let path = dir.join(format!("snap_{:05}.vtu", solver.frame()));
+        crate::sim_body::xpbd::write_solver_vtu(solver, &path)?;
+        Ok(format!("saved {}", path.display()))
     }
 }

@@ -28,7 +28,7 @@ use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{Headset, XrSession};
 use serde::Serialize;
 
-use crate::body::DeviceChoice;
+use crate::sim_body::DeviceChoice;
 use exercise::{AttemptSummary, XrExercise};
 use frame_loop::{LoopOptions, LoopOutcome, run_loop};
 use script::{HeadsetScript, Pacing, RightTrack};

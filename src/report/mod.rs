@@ -4,11 +4,17 @@
 //! releases, the edge models (mass-spring, rheology) displacement, volume and energy. A
 //! quantity a model does not compute is left out, never written as NaN or null.
 
+pub mod localisation;
+pub mod plot;
+
 use std::path::Path;
 
 use anyhow::{Context, Result};
 use incise_sim::xpbd::FrameStats;
 use serde::Serialize;
+
+use crate::scene::Scene;
+use crate::sim_body::method::Method;
 
 /// One frame's line in the report.
 #[derive(Debug, Clone, Serialize)]
@@ -118,6 +124,8 @@ pub struct Report {
     pub scene_file: String,
     /// Simulation model: "xpbd", "mass-spring" or "rheology".
     pub model: String,
+    /// Simulation method: "xpbd", "nakao" or "rheology" (every report has this schema).
+    pub method: Method,
     /// "completed" or "failed".
     pub status: String,
     /// The error that stopped the run, if any.
@@ -155,7 +163,7 @@ pub struct Report {
     pub haptic: Option<HapticInfo>,
     /// Levels, free nodes and loop-time split over the frames of a mass-spring run.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub localisation: Option<crate::loop_report::LocalisationInfo>,
+    pub localisation: Option<localisation::LocalisationInfo>,
 }
 
 /// Mesh figures for the report.
@@ -253,6 +261,39 @@ pub struct HapticInfo {
 }
 
 impl Report {
+    /// A running report of `scene` (file `path`) for model name and method `model`, with
+    /// its mesh figures and solver settings; the rest is filled by the body and the run.
+    pub fn begin(
+        scene: &Scene,
+        path: &Path,
+        model: (&str, Method),
+        mesh: MeshInfo,
+        solver: incise_sim::SolverParams,
+    ) -> Report {
+        Report {
+            scene: scene.name.clone(),
+            scene_file: path.display().to_string(),
+            model: model.0.into(),
+            method: model.1,
+            status: "running".into(),
+            error: None,
+            mesh,
+            material: None,
+            solver,
+            threads: 1,
+            device: "cpu".into(),
+            device_choice: None,
+            tool: None,
+            warnings: Vec::new(),
+            released_tets: Vec::new(),
+            frames: Vec::new(),
+            snapshots: Vec::new(),
+            rheology: None,
+            haptic: None,
+            localisation: None,
+        }
+    }
+
     /// Write as pretty JSON, atomically (temp file + rename).
     pub fn write(&self, path: &Path) -> Result<()> {
         let json = serde_json::to_vec_pretty(self)?;
