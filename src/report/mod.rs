@@ -158,6 +158,9 @@ pub struct Report {
     /// Materials per region and dent figures of a rheology scene.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rheology: Option<RheologyInfo>,
+    /// What the Nakao cutter did to the mesh: added nodes and tets, the wound's opening.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nakao: Option<NakaoInfo>,
     /// Loop rate and tool force of a haptic-rate run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub haptic: Option<HapticInfo>,
@@ -233,6 +236,22 @@ pub struct RheologyInfo {
     pub residual_dent_m: f64,
 }
 
+/// The Nakao cutter's result (PHYSICS.md §2.3–2.4, §2.6): what cutting added to the
+/// mesh and how far the wound opened under the tension.
+#[derive(Debug, Clone, Serialize)]
+pub struct NakaoInfo {
+    /// Nodes the cut added (duplicated and subdivision nodes).
+    pub nodes_added: usize,
+    /// Tets the cut added (subdivision).
+    pub tets_added: usize,
+    /// Area of the cut surfaces at the end, m².
+    pub cut_area_m2: f64,
+    /// Mean distance between the two copies of every node the cut duplicated, m (absent
+    /// when nothing was cut).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub opening_width_m: Option<f64>,
+}
+
 /// What the haptic-rate loop did (PHYSICS.md §2.6), all measured, none assumed.
 #[derive(Debug, Clone, Serialize)]
 pub struct HapticInfo {
@@ -289,6 +308,7 @@ impl Report {
             frames: Vec::new(),
             snapshots: Vec::new(),
             rheology: None,
+            nakao: None,
             haptic: None,
             localisation: None,
         }
@@ -327,6 +347,15 @@ impl Report {
                         r.max_dent_m * 1e3,
                         r.residual_dent_m * 1e3
                     );
+                }
+                if let Some(n) = &self.nakao {
+                    line += &format!(
+                        ", cut added {} nodes and {} tets",
+                        n.nodes_added, n.tets_added
+                    );
+                    if let Some(w) = n.opening_width_m {
+                        line += &format!(", wound open {:.2} mm", w * 1e3);
+                    }
                 }
                 if let Some(l) = &self.localisation {
                     line += &format!(

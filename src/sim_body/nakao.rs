@@ -14,14 +14,14 @@ use glam::{DVec3, Quat, Vec3};
 use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::mass_spring::{LocalLoop, LocalLoopParams, MassSpringModel, SystemClock};
-use incise_sim::nakao_cut::measure::{counts, cut_triangles};
+use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, opening_width};
 use incise_sim::nakao_cut::{BladePose, Cutter};
 
 use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, ToolInput};
 use super::nakao_blade::Blade;
 use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};
 use crate::report::localisation::{LocalisationInfo, LoopSample, LoopSplit};
-use crate::report::{EdgeFrameStats, FrameData, Report};
+use crate::report::{EdgeFrameStats, FrameData, NakaoInfo, Report};
 use crate::scene::{Localisation, MassSpringScene};
 
 /// The heat map of a Nakao body: the spring tension at each node.
@@ -295,9 +295,17 @@ pub fn write_model_vtu(m: &MassSpringModel, path: &Path) -> Result<()> {
     Ok(write_vtu(path, &frame)?)
 }
 
-/// Put `m`'s counts after cutting into the report's mesh figures; the closing line.
+/// Put `m`'s counts after cutting into the report's mesh figures and its Nakao section
+/// (added nodes and tets against the report's opening counts, the wound's opening);
+/// the closing line.
 pub fn counts_into(m: &MassSpringModel, report: &mut Report, frames: u64) -> String {
     let after = counts(m);
+    report.nakao = Some(NakaoInfo {
+        nodes_added: after.nodes.saturating_sub(report.mesh.nodes),
+        tets_added: after.tets.saturating_sub(report.mesh.tets),
+        cut_area_m2: cut_surface_area(m),
+        opening_width_m: opening_width(m, DVec3::ZERO, f64::INFINITY),
+    });
     report.mesh.nodes = after.nodes;
     report.mesh.tets = after.tets;
     report.mesh.skin_vertices = after.nodes;
