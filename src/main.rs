@@ -145,7 +145,7 @@ fn main() -> ExitCode {
             slow_sim_ms,
             inject_sim_panic_at,
         })
-        .map(|r| println!("{}", r.summary())),
+        .map(|summary| println!("{summary}")),
         Command::Render {
             scene,
             frame,

@@ -9,6 +9,7 @@ mod camera_input;
 pub mod display;
 mod frame_times;
 pub mod hand_tool;
+pub mod method_window;
 mod panel;
 pub mod pick;
 pub mod scalpel_input;
@@ -26,17 +27,11 @@ use winit::event::{ElementState, MouseButton, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Fullscreen, Window, WindowId};
 
-use crate::pictures::screenshots::{ImageSize, Screenshots, default_camera, stress_scale};
+use crate::pictures::screenshots::{ImageSize, Screenshots, stress_scale};
 use crate::sim_body::{Body, DeviceChoice};
 
-/// The preview's start view: the default one, a little farther out (the panel takes room).
-fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
-    let mut cam = default_camera(mesh);
-    cam.zoom(1.3);
-    cam
-}
 use crate::exercise::LiveExercise;
-use camera_input::{CameraInput, KeyAction, wheel_steps};
+use camera_input::{CameraInput, KeyAction, preview_camera, wheel_steps};
 use frame_times::{FrameTime, FrameTimes};
 use panel::{Action, ExerciseInfo, Panel, PanelInfo, ScalpelInfo};
 use session::{Session, scene_files};
@@ -73,6 +68,14 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
     if let Some(why) = display::missing_display() {
         bail!("{why}: the preview needs a window; use `incise run` or `incise render` headless");
     }
+    if opts.exercise.is_none() && !is_xpbd(&opts.scene)? {
+        return method_window::run(method_window::MethodWindow {
+            scene: opts.scene,
+            frames: opts.frames,
+            screenshot: opts.screenshot,
+            size: opts.size,
+        });
+    }
     let event_loop = EventLoop::new().map_err(|e| anyhow!("cannot open a window: {e}"))?;
     let mut app = App {
         opts,
@@ -82,7 +85,24 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("window event loop: {e}"))?;
+    if let Some(live) = app.live.as_ref().filter(|_| app.result.is_ok()) {
+        let solver = live.session.body.solver();
+        println!(
+            "preview of {}: {} frames, {} tets released",
+            live.session.name(),
+            solver.frame(),
+            solver.cut().released_count()
+        );
+    }
     app.result
+}
+
+/// Whether the scene at `path` runs the XPBD method (the full preview with its panel of
+/// solver settings, exercises and stroke recording); other methods get a
+/// [`method_window`].
+fn is_xpbd(path: &Path) -> Result<bool> {
+    let scene = crate::scene::load_scene(path)?;
+    Ok(matches!(scene.model, crate::scene::ModelChoice::Xpbd))
 }
 
 struct App {

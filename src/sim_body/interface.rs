@@ -52,6 +52,21 @@ pub struct Surface {
     pub quantity: Option<Quantity>,
 }
 
+/// The body as tets for the renderer (which draws a tet mesh's skin and colours the
+/// heat map per tet).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TetView {
+    /// Node positions now, m.
+    pub positions: Vec<Vec3>,
+    /// The tets (node indices); they change when a method cuts by remodelling.
+    pub tets: Vec<[u32; 4]>,
+    /// The heat-map quantity per tet (mean over its nodes or the method's own per-tet
+    /// value).
+    pub per_tet: Vec<f32>,
+    /// What [`TetView::per_tet`] is.
+    pub quantity: Option<Quantity>,
+}
+
 /// Why a frame could not be stepped; the body is left at its last completed frame.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepError {
@@ -110,6 +125,9 @@ pub trait SimBody {
 
     /// The surface to draw, with the method's heat-map quantity per vertex.
     fn surface(&self) -> Surface;
+
+    /// The body as tets for the renderer, with the heat-map quantity per tet.
+    fn tet_view(&self) -> TetView;
 
     /// Write the body's state as a `.vtu` file at `path`.
     fn write_vtu(&self, path: &Path) -> anyhow::Result<()>;

@@ -16,7 +16,9 @@ pub mod vertex_field;
 pub mod xpbd;
 pub mod xpbd_device;
 
-pub use interface::{Fault, OpenOptions, Quantity, SimBody, StepError, Surface, ToolInput};
+pub use interface::{
+    Fault, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
+};
 pub use method::Method;
 pub use open::open;
 pub use xpbd_device::{Body, DeviceChoice, auto_device};

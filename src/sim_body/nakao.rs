@@ -13,11 +13,13 @@ use anyhow::{Result, bail};
 use glam::{DVec3, Quat, Vec3};
 use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
-use incise_sim::mass_spring::{LocalLoop, LocalLoopParams, MassSpringModel, SystemClock};
+use incise_sim::mass_spring::{
+    HapticConfig, LocalLoop, LocalLoopParams, MassSpringModel, SystemClock,
+};
 use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, opening_width};
 use incise_sim::nakao_cut::{BladePose, Cutter};
 
-use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, ToolInput};
+use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
 use super::nakao_blade::Blade;
 use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};
 use crate::report::localisation::{LocalisationInfo, LoopSample, LoopSplit};
@@ -47,6 +49,8 @@ pub struct NakaoBody {
     frame_dt: f64,
     frame: u64,
     total_volume: f64,
+    /// Force of the tissue on a hand's tool in the last frame (`None`: scripted blade).
+    force: Option<DVec3>,
 }
 
 impl NakaoBody {
@@ -70,6 +74,7 @@ impl NakaoBody {
             frame_dt,
             frame: 0,
             total_volume,
+            force: None,
         }
     }
 
@@ -153,6 +158,26 @@ impl NakaoBody {
         }
     }
 
+    /// A hand's tool point (the middle of the blade edge) coupled to the nearest node
+    /// within the contact radius by the haptic loop's virtual spring (PHYSICS.md §2.6),
+    /// for the frame; the force of the tissue on the tool.
+    fn couple(&mut self) -> DVec3 {
+        let Some(p) = self.pose else {
+            return DVec3::ZERO;
+        };
+        let tip = (p.heel + p.tip) * 0.5;
+        let config = HapticConfig::default();
+        let near = self.model.nearest_node(tip).filter(|&n| {
+            (self.model.positions()[n as usize] - tip).length() <= config.contact_radius
+        });
+        let Some(n) = near else {
+            return DVec3::ZERO;
+        };
+        let f = config.coupling * (tip - self.model.positions()[n as usize]);
+        self.model.set_external_force(n, f);
+        -f
+    }
+
     /// Go back to the last completed frame, the blade lifted.
     fn roll_back(&mut self) {
         self.model = self.last_good.clone();
@@ -179,8 +204,10 @@ impl SimBody for NakaoBody {
     fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError> {
         let t0 = Instant::now();
         let cut_ms = self.cut(tool);
+        self.force = matches!(tool, ToolInput::Hand { .. }).then(|| self.couple());
         let steps = (self.frame_dt / self.model.stable_dt()).ceil().max(1.0) as u32;
         let sample = self.integrate(self.frame_dt / steps as f64, steps, cut_ms);
+        self.model.clear_external_forces();
         if let Some(i) = self.model.positions().iter().position(|p| !p.is_finite()) {
             self.roll_back();
             return Err(StepError::Failed(format!(
@@ -199,17 +226,21 @@ impl SimBody for NakaoBody {
 
     fn tool_pose(&self) -> Option<ToolPose> {
         self.pose.map(|p| ToolPose {
-            position: p.heel.as_vec3(),
+            position: p.tip.as_vec3(),
             rotation: Quat::IDENTITY,
         })
     }
 
     fn tool_force(&self) -> Option<Vec3> {
-        None
+        self.force.map(|f| f.as_vec3())
     }
 
     fn surface(&self) -> Surface {
         surface_of(&self.model)
+    }
+
+    fn tet_view(&self) -> TetView {
+        tet_view_of(&self.model)
     }
 
     fn write_vtu(&self, path: &Path) -> Result<()> {
@@ -271,6 +302,21 @@ pub fn surface_of(m: &MassSpringModel) -> Surface {
         triangles: surface_triangles(m),
         cut_triangles: cut_triangles(m),
         scalar: tension_at_nodes(m),
+        quantity: Some(TENSION),
+    }
+}
+
+/// `m` as tets with the mean spring tension of each tet's nodes.
+pub fn tet_view_of(m: &MassSpringModel) -> TetView {
+    let tension = tension_at_nodes(m);
+    TetView {
+        positions: m.positions().iter().map(|p| p.as_vec3()).collect(),
+        tets: m.tets().to_vec(),
+        per_tet: m
+            .tets()
+            .iter()
+            .map(|t| t.iter().map(|&n| tension[n as usize]).sum::<f32>() / 4.0)
+            .collect(),
         quantity: Some(TENSION),
     }
 }

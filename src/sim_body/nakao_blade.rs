@@ -1,6 +1,7 @@
 //! The Nakao cutter's blade (PHYSICS.md §2.3): a straight cutting edge from heel to tip,
 //! moved by the scene's `model.stroke` (at constant speed from its start time) or by a
-//! hand's tool pose (the heel at the tool's origin, the edge turned with the tool).
+//! hand's tool pose (the tip at the tool's origin, the edge hanging below it, turned with
+//! the tool).
 
 use glam::{DQuat, DVec3};
 use incise_sim::nakao_cut::BladePose;
@@ -43,11 +44,11 @@ impl Blade {
                 Some((pose, progress > 0.0 && progress < 1.0, begin))
             }
             ToolInput::Hand { pose, engaged } => {
-                let heel = pose.position.as_dvec3();
+                let tip = pose.position.as_dvec3();
                 let turn = DQuat::from_array(pose.rotation.to_array().map(f64::from));
                 let blade = BladePose {
-                    heel,
-                    tip: heel + turn * self.edge,
+                    heel: tip - turn * self.edge,
+                    tip,
                 };
                 Some((blade, *engaged, previous.unwrap_or(blade)))
             }
@@ -113,7 +114,9 @@ mod tests {
         };
         let (blade, engaged, begin) = b.at(&hand, 0.0, None).unwrap();
         assert!(engaged && begin == blade);
-        // +z turned a quarter about y is +x: the 8 mm edge now lies along x.
+        // +z turned a quarter about y is +x: the 8 mm edge now lies along x, its tip at
+        // the tool's origin.
         assert!((blade.tip - blade.heel - DVec3::new(0.008, 0.0, 0.0)).length() < 1e-6);
+        assert!((blade.tip - DVec3::new(0.01, 0.0, 0.0)).length() < 1e-6);
     }
 }

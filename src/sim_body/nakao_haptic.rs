@@ -14,7 +14,7 @@ use incise_sim::contact::ToolPose;
 use incise_sim::mass_spring::{HapticConfig, HapticLoop, LocalLoopParams, MassSpringModel};
 use incise_sim::nakao_cut::BladePose;
 
-use super::interface::{Fault, Method, SimBody, StepError, Surface, ToolInput};
+use super::interface::{Fault, Method, SimBody, StepError, Surface, TetView, ToolInput};
 use super::nakao_blade::Blade;
 use crate::report::{EdgeFrameStats, FrameData, HapticInfo, Report};
 use crate::scene::{Localisation, MassSpringScene, StrokeSpec};
@@ -150,7 +150,7 @@ impl SimBody for NakaoHapticBody {
 
     fn tool_pose(&self) -> Option<ToolPose> {
         self.pose.map(|p| ToolPose {
-            position: p.heel.as_vec3(),
+            position: p.tip.as_vec3(),
             rotation: Quat::IDENTITY,
         })
     }
@@ -172,6 +172,13 @@ impl SimBody for NakaoHapticBody {
                 ..Surface::default()
             },
             Holder::Stopped => Surface::default(),
+        }
+    }
+
+    fn tet_view(&self) -> TetView {
+        match &self.holder {
+            Holder::Here(m) => super::nakao::tet_view_of(m),
+            _ => TetView::default(),
         }
     }
 

@@ -15,7 +15,7 @@ use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::rheology::{FlatIndenter, PressSchedule, RheologyBody as Model};
 
-use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, ToolInput};
+use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
 use crate::report::{EdgeFrameStats, FrameData, Report};
 use crate::scene::IndenterSpec;
 
@@ -251,6 +251,21 @@ impl SimBody for RheologyBody {
             triangles: self.mesh.boundary_triangles(),
             cut_triangles: Vec::new(),
             scalar: self.strain_at_nodes(),
+            quantity: Some(STRAIN),
+        }
+    }
+
+    fn tet_view(&self) -> TetView {
+        let strain = self.strain_at_nodes();
+        TetView {
+            positions: self.model.positions().iter().map(|p| p.as_vec3()).collect(),
+            tets: self.mesh.tets.clone(),
+            per_tet: self
+                .mesh
+                .tets
+                .iter()
+                .map(|t| t.iter().map(|&n| strain[n as usize]).sum::<f32>() / 4.0)
+                .collect(),
             quantity: Some(STRAIN),
         }
     }

@@ -13,7 +13,7 @@ use incise_sim::skin::Skin;
 use incise_sim::xpbd::SolverError;
 
 use super::interface::{
-    Fault, Method, OpenOptions, Quantity, SimBody, StepError, Surface, ToolInput,
+    Fault, Method, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
 };
 use super::vertex_field::vertex_mean;
 use super::xpbd_device::Body;
@@ -215,6 +215,16 @@ impl SimBody for XpbdBody {
             }
         }
         surface
+    }
+
+    fn tet_view(&self) -> TetView {
+        let s = self.body.solver();
+        TetView {
+            positions: s.positions().to_vec(),
+            tets: s.mesh().tets.clone(),
+            per_tet: s.von_mises().to_vec(),
+            quantity: Some(VON_MISES),
+        }
     }
 
     fn write_vtu(&self, path: &Path) -> Result<()> {
