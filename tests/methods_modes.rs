@@ -238,3 +238,55 @@ fn rheology_headset_presses_and_creeps_back() {
         "crept back to {end} m from {max} m"
     );
 }
+
+/// The scene files shipped in config/ (the `.ron` files that are scenes, not presets).
+fn shipped_scenes() -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut scenes: Vec<String> = std::fs::read_dir(root.join("config"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .filter(|p| incise::scene::load_scene(p).is_ok())
+        .map(|p| format!("config/{}", p.file_name().unwrap().to_string_lossy()))
+        .collect();
+    scenes.sort();
+    scenes
+}
+
+#[test]
+fn every_shipped_scene_opens_in_the_preview_and_on_the_headset() {
+    let scenes = shipped_scenes();
+    // All three methods are among them.
+    for s in [
+        "plate_cut.ron",
+        "plate_cut_nakao.ron",
+        "chest_incision_nakao.ron",
+        "organ_layers.ron",
+    ] {
+        assert!(
+            scenes.iter().any(|x| x.ends_with(s)),
+            "{s} not found in {scenes:?}"
+        );
+    }
+    let dir = temp_dir("mm-every");
+    // 4 display frames, every other one drawn.
+    let text = std::fs::read_to_string(script(&dir, 0.05, "")).unwrap();
+    let tiny_path = dir.join("tiny.ron");
+    std::fs::write(
+        &tiny_path,
+        text.replace("render_every: 24", "render_every: 2"),
+    )
+    .unwrap();
+    for scene in &scenes {
+        if let Some(out) = preview("mm-every-preview", scene, 3) {
+            assert!(out.contains(" frames"), "preview of {scene}: {out}");
+        }
+        let out = dir.join("xr");
+        if let Some(stdout) = headset(scene, &tiny_path, &out) {
+            assert!(
+                stdout.contains("display frames"),
+                "headset on {scene}: {stdout}"
+            );
+        }
+    }
+}
