@@ -5,10 +5,10 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use incise_sim::TetMesh;
 use incise_sim::rheology::{
     MaterialMap, MaterialRegion, RegionShape, RheologyBody as Model, RheologyError, RheologyPresets,
 };
+use incise_sim::{MeshBuildReport, TetMesh};
 
 use super::interface::{Method, OpenOptions};
 use super::rheology::{Press, RheologyBody};
@@ -22,18 +22,7 @@ pub fn open(
     path: &Path,
     opts: &OpenOptions,
 ) -> Result<(RheologyBody, Report)> {
-    if opts.haptic_rate.is_some() {
-        bail!(
-            "{}: --haptic-rate runs the mass-spring haptic loop; this scene's model is Rheology",
-            path.display()
-        );
-    }
-    if !scene.grabs.is_empty() {
-        bail!(
-            "{}: grabs are not supported by the Rheology model (use model.indenter)",
-            path.display()
-        );
-    }
+    refuse(scene, path, opts)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let (raw, _) = raw_mesh(&scene.mesh, dir)?;
     let (mesh, mesh_report) =
@@ -46,6 +35,42 @@ pub fn open(
     let rows = material_rows(&map, &names);
     let mut model =
         Model::new(&mesh, &materials, map).with_context(|| format!("{}: model", path.display()))?;
+    let pinned = pin(&mut model, scene, &mesh, path)?;
+    model.set_gravity(scene.solver.gravity.as_dvec3());
+    let limit = model.stability();
+    let mut report = skeleton(scene, path, &mesh, &mesh_report, pinned);
+    report.rheology = Some(RheologyInfo {
+        presets_file: presets_path.display().to_string(),
+        materials: rows,
+        stability_limit_s: limit.max_step,
+        step_s: limit.safe_step(),
+        max_dent_m: 0.0,
+        residual_dent_m: 0.0,
+    });
+    let press = Press::of_scene(&mesh, rh.indenter.as_ref());
+    let body = RheologyBody::new(model, mesh, press, scene.solver.frame_dt as f64);
+    Ok((body, report))
+}
+
+/// What a rheology scene cannot have: the haptic-rate loop, grabs.
+fn refuse(scene: &Scene, path: &Path, opts: &OpenOptions) -> Result<()> {
+    if opts.haptic_rate.is_some() {
+        bail!(
+            "{}: --haptic-rate runs the mass-spring haptic loop; this scene's model is Rheology",
+            path.display()
+        );
+    }
+    if !scene.grabs.is_empty() {
+        bail!(
+            "{}: grabs are not supported by the Rheology model (use model.indenter)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Pin the scene's pins; the pinned count.
+fn pin(model: &mut Model, scene: &Scene, mesh: &TetMesh, path: &Path) -> Result<usize> {
     let mut pinned = 0;
     for (i, sel) in scene.pins.iter().enumerate() {
         let nodes = sel
@@ -54,8 +79,17 @@ pub fn open(
         pinned += nodes.len();
         model.pin(&nodes);
     }
-    model.set_gravity(scene.solver.gravity.as_dvec3());
-    let limit = model.stability();
+    Ok(pinned)
+}
+
+/// The report's head of a rheology run.
+fn skeleton(
+    scene: &Scene,
+    path: &Path,
+    mesh: &TetMesh,
+    mesh_report: &MeshBuildReport,
+    pinned: usize,
+) -> Report {
     let mut report = Report::begin(
         scene,
         path,
@@ -74,17 +108,7 @@ pub fn open(
         scene.solver.clone(),
     );
     report.device = "cpu (rheology)".into();
-    report.rheology = Some(RheologyInfo {
-        presets_file: presets_path.display().to_string(),
-        materials: rows,
-        stability_limit_s: limit.max_step,
-        step_s: limit.safe_step(),
-        max_dent_m: 0.0,
-        residual_dent_m: 0.0,
-    });
-    let press = Press::of_scene(&mesh, rh.indenter.as_ref());
-    let body = RheologyBody::new(model, mesh, press, scene.solver.frame_dt as f64);
-    Ok((body, report))
+    report
 }
 
 /// The material list: the default first, then one per region (duplicates are harmless).
