@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use crate::body::DeviceChoice;
-use crate::screenshots::{ImageSize, OverlayArg};
+use crate::pictures::screenshots::{ImageSize, OverlayArg};
+use crate::sim_body::DeviceChoice;
 use crate::xr::sim_mode::SimChoice;
 
 /// incise: mixed-reality surgical cutting trainer (headless runner, mesh tools, benchmarks).

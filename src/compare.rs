@@ -6,8 +6,8 @@ use std::path::Path;
 use anyhow::{Result, bail};
 use serde::Serialize;
 
-use crate::body::{Body, DeviceChoice};
 use crate::scene::{build_scene, load_scene};
+use crate::sim_body::{Body, DeviceChoice};
 
 /// Largest position difference allowed, as a fraction of the mesh's bounding-box diagonal.
 pub const POSITION_TOLERANCE: f32 = 1e-4;

@@ -3,13 +3,13 @@
 use std::process::ExitCode;
 
 use clap::Parser;
+use incise::bench::{self, realtime as bench_realtime, render as bench_render};
 use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
+use incise::pictures::screenshots;
+use incise::pictures::screenshots::ImageSize;
 use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
-use incise::screenshots::ImageSize;
-use incise::{
-    bench, bench_realtime, bench_render, compare, exercise, experiment, mesh_cmd, screenshots,
-};
+use incise::{compare, exercise, experiment, mesh_cmd};
 
 /// The scene opened when none is named.
 const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
@@ -25,7 +25,7 @@ fn default_command() -> Command {
             scene: None,
             frames: None,
             screenshot: None,
-            device: incise::body::DeviceChoice::Auto,
+            device: incise::sim_body::DeviceChoice::Auto,
             size: ImageSize(1280, 800),
             exercise: None,
         },
@@ -40,7 +40,7 @@ fn default_command() -> Command {
                 vtu_every: 10,
                 threads: None,
                 quiet: false,
-                device: incise::body::DeviceChoice::Auto,
+                device: incise::sim_body::DeviceChoice::Auto,
                 screenshot_every: 0,
                 screenshot_size: ImageSize(960, 540),
                 haptic_rate: None,
@@ -145,7 +145,7 @@ fn main() -> ExitCode {
             slow_sim_ms,
             inject_sim_panic_at,
         })
-        .map(|r| println!("{}", r.summary())),
+        .map(|summary| println!("{summary}")),
         Command::Render {
             scene,
             frame,
@@ -215,7 +215,7 @@ fn main() -> ExitCode {
             device,
             out,
             markdown,
-        } => incise::soak::run(&incise::soak::SoakOptions {
+        } => incise::bench::soak::run(&incise::bench::soak::SoakOptions {
             scene,
             seconds,
             device,
@@ -236,7 +236,7 @@ fn main() -> ExitCode {
             );
             println!("report: {}", out.join("soak.json").display());
             if markdown {
-                print!("\n{}", incise::soak::markdown(&r));
+                print!("\n{}", incise::bench::soak::markdown(&r));
             }
             if r.passed {
                 Ok(())

@@ -26,7 +26,7 @@ pub fn provenance() -> Provenance {
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
         .unwrap_or_else(|_| "unknown".into());
     Provenance {
-        machine: crate::bench::machine(),
+        machine: machine(),
         date_utc: date,
         load_average: load,
     }
@@ -49,4 +49,19 @@ pub fn generated_by() -> String {
         p.date_utc,
         p.load_average
     )
+}
+
+/// CPU model name and logical core count.
+pub fn machine() -> String {
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    format!("{model}, {cores} logical cores")
 }

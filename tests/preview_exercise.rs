@@ -9,11 +9,11 @@ mod common;
 use std::path::Path;
 
 use common::{score_stroke, temp_dir};
-use incise::body::Body;
 use incise::exercise::LiveExercise;
+use incise::pictures::screenshots::{ImageSize, Screenshots, default_camera};
 use incise::preview::hand_tool::HandTool;
 use incise::scene::{ToolDriver, build_scene_driven};
-use incise::screenshots::{ImageSize, Screenshots, default_camera};
+use incise::sim_body::Body;
 use serde_json::Value;
 
 const EXERCISE: &str = "config/exercises/slab_depth.ron";

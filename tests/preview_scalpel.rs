@@ -8,11 +8,11 @@ mod common;
 
 use common::{incise, temp_dir, text};
 use glam::{Vec2, Vec3};
-use incise::body::Body;
+use incise::pictures::screenshots::default_camera;
 use incise::preview::hand_tool::HandTool;
 use incise::preview::pick::pick_tissue;
 use incise::scene::{ToolDriver, build_scene_driven, load_scene};
-use incise::screenshots::default_camera;
+use incise::sim_body::Body;
 use serde_json::Value;
 
 /// Released tets of a body.

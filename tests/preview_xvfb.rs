@@ -291,7 +291,7 @@ fn preview_window_shows_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
     let built =
         incise::scene::build_scene(&scene, std::path::Path::new("config/plate_cut.ron"), None)
             .unwrap();
-    let mut cam = incise::screenshots::default_camera(built.solver.mesh());
+    let mut cam = incise::pictures::screenshots::default_camera(built.solver.mesh());
     cam.zoom(1.3);
     let mut view = cam.view(w as f32 / h as f32);
     let shift = panel as f32 / w as f32;

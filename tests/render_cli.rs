@@ -189,7 +189,8 @@ fn render_draws_the_scalpel_mesh_and_its_spheres() {
         .unwrap()
         .pose_at(0.0);
     let mid = pose.transform_point(glam::Vec3::new(0.015, 0.0, 0.0));
-    let view = incise::screenshots::default_camera(built.solver.mesh()).view(320.0 / 180.0);
+    let view =
+        incise::pictures::screenshots::default_camera(built.solver.mesh()).view(320.0 / 180.0);
     let px = view.project(mid, glam::Vec2::new(320.0, 180.0)).unwrap();
     let (x, y) = (px.x as u32, px.y as u32);
     let (a, b) = (tool.get(x, y), plain.get(x, y));

@@ -8,19 +8,18 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use incise_sim::xpbd::FrameStats;
-use serde::Serialize;
 
 use super::decal::PlanDecal;
 use super::history::{self, HistoryEntry};
 use super::load::{LoadedExercise, load_exercise};
-use super::metrics::{self, Metrics};
-use super::model::{PassThresholds, Tolerance};
+use super::metrics;
 use super::report_html::{self, CutImages};
-use super::score::{self, Verdict};
-use crate::body::DeviceChoice;
+pub use super::result::ExerciseResult;
+use super::score;
+use crate::pictures::screenshots::ImageSize;
 use crate::report::FrameData;
 use crate::run::{RunOptions, run_scene};
-use crate::screenshots::ImageSize;
+use crate::sim_body::DeviceChoice;
 
 /// Simulated time after the stroke's last key, so the tissue settles and late releases
 /// are counted, s.
@@ -41,41 +40,6 @@ pub struct ExerciseOptions {
     pub history: PathBuf,
     /// No progress output.
     pub quiet: bool,
-}
-
-/// Everything `result.json` holds.
-#[derive(Debug, Clone, Serialize)]
-pub struct ExerciseResult {
-    /// Exercise name.
-    pub exercise: String,
-    /// Exercise file.
-    pub exercise_file: String,
-    /// The exercise's description.
-    pub description: String,
-    /// Scene file.
-    pub scene_file: String,
-    /// Stroke file.
-    pub stroke_file: String,
-    /// Device the solver ran on.
-    pub device: String,
-    /// When it was scored, UTC.
-    pub time: String,
-    /// Frames simulated.
-    pub frames: u64,
-    /// The plan projected onto the organ's rest surface, m.
-    pub plan: Vec<[f64; 3]>,
-    /// Target depth, m.
-    pub target_depth: f32,
-    /// Tolerance band.
-    pub tolerance: Tolerance,
-    /// Time limit, s.
-    pub time_limit: f32,
-    /// Pass thresholds.
-    pub thresholds: PassThresholds,
-    /// The measurements.
-    pub metrics: Metrics,
-    /// Score and checks.
-    pub verdict: Verdict,
 }
 
 /// What a scored attempt produced.

@@ -15,8 +15,8 @@ use super::{
     Attempt, CutImages, LoadedExercise, PlanDecal, ReferenceStyle, Standing, load_exercise,
     read_history, reference_stroke, render_card, save_attempt, score_attempt,
 };
-use crate::body::Body;
-use crate::screenshots::Screenshots;
+use crate::pictures::screenshots::Screenshots;
+use crate::sim_body::Body;
 
 /// Where a live attempt's scalpel path is recorded: the preview's hand tool, the XR
 /// mode's controller.

@@ -13,12 +13,11 @@ mod model;
 mod plan;
 mod reference;
 mod report_html;
+mod result;
 mod result_card;
 mod score;
 
-pub use attempt::{
-    Attempt, ExerciseOptions, ExerciseResult, run_exercise, save_attempt, score_attempt,
-};
+pub use attempt::{Attempt, ExerciseOptions, run_exercise, save_attempt, score_attempt};
 pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, PlanDecal};
 pub use history::{
     HistoryEntry, append as append_history, read as read_history, table as history_table, utc_now,
@@ -30,5 +29,6 @@ pub use model::{Exercise, PassThresholds, Tolerance};
 pub use plan::{Plan, PlanCoords, PlanSample, RestSurface};
 pub use reference::{ReferenceStyle, reference_stroke, write_reference_stroke};
 pub use report_html::CutImages;
+pub use result::ExerciseResult;
 pub use result_card::{BANNER, CARD_SIZE, FAIL_COLOUR, PASS_COLOUR, Standing, render_card};
 pub use score::{Check, Verdict, WEIGHTS, Weights, judge};

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use super::attempt::ExerciseResult;
-use crate::plot::{LineChart, Series, write_line_chart};
+use super::result::ExerciseResult;
+use crate::report::plot::{LineChart, Series, write_line_chart};
 
 /// Pictures of the cut, or why there are none.
 pub enum CutImages<'a> {

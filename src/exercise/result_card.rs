@@ -60,7 +60,7 @@ impl Standing {
 /// Draw the card of `result` ([`CARD_SIZE`], opaque sRGB RGBA8), with its `standing` in
 /// the history when known. Non-finite numbers are drawn as they print ("NaN").
 pub fn render_card(result: &ExerciseResult, standing: Option<Standing>) -> Result<RgbaImage> {
-    crate::plot::register_fonts();
+    crate::report::plot::register_fonts();
     let (w, h) = CARD_SIZE;
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     draw(&mut rgb, result, standing).map_err(|e| anyhow!("drawing the result card: {e}"))?;

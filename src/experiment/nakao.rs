@@ -12,7 +12,7 @@ use incise_sim::mass_spring::MassSpringModel;
 use incise_sim::nakao_cut::{PlateCutResult, PlateCutSetup, Subdivision, run_plate_cut};
 use rayon::prelude::*;
 
-use crate::plot::{
+use crate::report::plot::{
     LineChart, SegmentLayer, SegmentPanel, Series, write_line_chart, write_segment_panels,
 };
 

@@ -142,7 +142,7 @@ pub fn run(opts: &NakaoBenchOptions) -> Result<()> {
     }
     results.push(summary("blade advance (cut)", &mut cut_ms, &[], None));
     let report = NakaoBench {
-        machine: crate::bench::machine(),
+        machine: crate::provenance::machine(),
         mesh,
         results,
     };

@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use incise_sim::nakao_cut::{PlateCutResult, PlateCutSetup, Subdivision, run_plate_cut};
 use rayon::prelude::*;
 
-use crate::plot::{LineChart, Series, write_line_chart};
+use crate::report::plot::{LineChart, Series, write_line_chart};
 
 /// The paper's added counts for the plate (1,274 → 1,505 nodes, 3,647 → 4,301 tets).
 pub const PAPER_ADDED: (usize, usize) = (231, 654);

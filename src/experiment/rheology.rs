@@ -15,7 +15,7 @@ use incise_sim::rheology::{
 };
 use rayon::prelude::*;
 
-use crate::plot::{
+use crate::report::plot::{
     LineChart, SegmentLayer, SegmentPanel, Series, write_line_chart, write_segment_panels,
 };
 

@@ -2,6 +2,7 @@
 //! is the scalpel's), middle-drag or shift+right-drag pans, the wheel zooms, arrow keys orbit, +/- zoom, R resets
 //! the view, F (or F11) toggles fullscreen, Space plays/pauses, Escape quits.
 
+use incise_sim::TetMesh;
 use incise_xr::Camera;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta};
 use winit::keyboard::{Key, NamedKey};
@@ -99,4 +100,12 @@ pub fn wheel_steps(delta: MouseScrollDelta) -> f32 {
         MouseScrollDelta::LineDelta(_, y) => y,
         MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
     }
+}
+
+/// The preview's start view of `mesh`: the default one, a little farther out (the panel
+/// takes room).
+pub fn preview_camera(mesh: &TetMesh) -> Camera {
+    let mut cam = crate::pictures::screenshots::default_camera(mesh);
+    cam.zoom(1.3);
+    cam
 }

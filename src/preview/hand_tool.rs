@@ -13,8 +13,8 @@ use incise_sim::contact::{ContactTool, ToolPose};
 use incise_sim::xpbd::FrameStats;
 
 use super::scalpel_input::{BladeGeometry, ScalpelFeel, ScalpelInput};
-use crate::body::Body;
 use crate::scene::SceneTool;
+use crate::sim_body::Body;
 
 /// A finished recording.
 #[derive(Debug, Clone, PartialEq)]

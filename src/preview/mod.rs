@@ -9,6 +9,7 @@ mod camera_input;
 pub mod display;
 mod frame_times;
 pub mod hand_tool;
+pub mod method_window;
 mod panel;
 pub mod pick;
 pub mod scalpel_input;
@@ -26,17 +27,11 @@ use winit::event::{ElementState, MouseButton, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Fullscreen, Window, WindowId};
 
-use crate::body::{Body, DeviceChoice};
-use crate::screenshots::{ImageSize, Screenshots, default_camera, stress_scale};
+use crate::pictures::screenshots::{ImageSize, Screenshots, stress_scale};
+use crate::sim_body::{Body, DeviceChoice};
 
-/// The preview's start view: the default one, a little farther out (the panel takes room).
-fn preview_camera(mesh: &incise_sim::TetMesh) -> Camera {
-    let mut cam = default_camera(mesh);
-    cam.zoom(1.3);
-    cam
-}
 use crate::exercise::LiveExercise;
-use camera_input::{CameraInput, KeyAction, wheel_steps};
+use camera_input::{CameraInput, KeyAction, preview_camera, wheel_steps};
 use frame_times::{FrameTime, FrameTimes};
 use panel::{Action, ExerciseInfo, Panel, PanelInfo, ScalpelInfo};
 use session::{Session, scene_files};
@@ -73,6 +68,14 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
     if let Some(why) = display::missing_display() {
         bail!("{why}: the preview needs a window; use `incise run` or `incise render` headless");
     }
+    if opts.exercise.is_none() && !is_xpbd(&opts.scene)? {
+        return method_window::run(method_window::MethodWindow {
+            scene: opts.scene,
+            frames: opts.frames,
+            screenshot: opts.screenshot,
+            size: opts.size,
+        });
+    }
     let event_loop = EventLoop::new().map_err(|e| anyhow!("cannot open a window: {e}"))?;
     let mut app = App {
         opts,
@@ -82,7 +85,24 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("window event loop: {e}"))?;
+    if let Some(live) = app.live.as_ref().filter(|_| app.result.is_ok()) {
+        let solver = live.session.body.solver();
+        println!(
+            "preview of {}: {} frames, {} tets released",
+            live.session.name(),
+            solver.frame(),
+            solver.cut().released_count()
+        );
+    }
     app.result
+}
+
+/// Whether the scene at `path` runs the XPBD method (the full preview with its panel of
+/// solver settings, exercises and stroke recording); other methods get a
+/// [`method_window`].
+fn is_xpbd(path: &Path) -> Result<bool> {
+    let scene = crate::scene::load_scene(path)?;
+    Ok(matches!(scene.model, crate::scene::ModelChoice::Xpbd))
 }
 
 struct App {
@@ -225,7 +245,7 @@ impl Live {
         let device = match opts.device {
             // A software adapter runs the CPU solver faster than its own compute.
             DeviceChoice::Auto => {
-                let (pick, why) = crate::body::auto_device(&gpu.dev.info);
+                let (pick, why) = crate::sim_body::auto_device(&gpu.dev.info);
                 eprintln!("note: {why}");
                 pick
             }
@@ -253,7 +273,7 @@ impl Live {
             session.body.solver().mesh(),
             &session.skin,
         );
-        renderer.set_tool_mesh(&crate::tool_view::tool_mesh(&session.hand.tool));
+        renderer.set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&session.hand.tool));
         let egui = egui::Context::default();
         let egui_winit = egui_winit::State::new(
             egui.clone(),
@@ -409,7 +429,7 @@ impl Live {
         let settings = RenderSettings {
             overlays: self.panel.overlays,
             stress_max: stress_scale(solver),
-            tool: crate::tool_view::tool_state(solver),
+            tool: crate::pictures::tool_view::tool_state(solver),
             lines: self
                 .exercise
                 .iter()
@@ -496,7 +516,7 @@ impl Live {
             &s.skin,
         );
         self.renderer
-            .set_tool_mesh(&crate::tool_view::tool_mesh(&s.hand.tool));
+            .set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&s.hand.tool));
         self.home = preview_camera(s.body.solver().mesh());
         self.camera = self.home;
         self.panel.draft = s.params;
@@ -673,8 +693,8 @@ impl Live {
         let dir = PathBuf::from("out/preview");
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         let solver = self.session.body.solver();
-        let mut pvd = Vec::new();
-        crate::run::snapshot(&dir, solver, solver.frame(), &mut pvd)?;
-        Ok(format!("saved {}", dir.join(&pvd[0].1).display()))
+        let path = dir.join(format!("snap_{:05}.vtu", solver.frame()));
+        crate::sim_body::xpbd::write_solver_vtu(solver, &path)?;
+        Ok(format!("saved {}", path.display()))
     }
 }

@@ -12,7 +12,7 @@ use incise_xr::colour_map::turbo;
 
 use super::frame_times::FrameTimes;
 use super::session::LiveParams;
-use crate::body::DeviceChoice;
+use crate::sim_body::DeviceChoice;
 
 /// What the user asked for this frame.
 #[derive(Debug, Clone, PartialEq)]

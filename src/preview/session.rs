@@ -14,9 +14,9 @@ use incise_sim::{Material, Solver};
 use incise_xr::RenderDevice;
 
 use super::hand_tool::HandTool;
-use crate::body::{Body, DeviceChoice};
+use crate::pictures::screenshots::{default_camera, place_on};
 use crate::scene::{Scene, ToolDriver, build_scene_driven, load_scene};
-use crate::screenshots::{default_camera, place_on};
+use crate::sim_body::{Body, DeviceChoice};
 
 /// Settings the panel changes while the scene runs.
 #[derive(Debug, Clone, Copy, PartialEq)]

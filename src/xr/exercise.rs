@@ -19,9 +19,9 @@ use incise_xr::{RenderDevice, Renderer, RgbaImage, SurfaceLine};
 use serde::Serialize;
 
 use super::xr_body::XrBody;
-use crate::body::Body;
 use crate::exercise::{LiveExercise, LoadedExercise, StrokeSource};
-use crate::screenshots::{ImageSize, Screenshots};
+use crate::pictures::screenshots::{ImageSize, Screenshots};
+use crate::sim_body::Body;
 
 /// Size of the report's before/after pictures, pixels.
 const PICTURE: ImageSize = ImageSize(960, 540);

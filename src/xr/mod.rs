@@ -7,6 +7,7 @@ pub mod frame_log;
 pub mod frame_loop;
 pub mod in_frame;
 pub mod latest;
+pub mod method_session;
 pub mod script;
 pub mod sim_mode;
 pub mod sim_source;
@@ -28,7 +29,7 @@ use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{Headset, XrSession};
 use serde::Serialize;
 
-use crate::body::DeviceChoice;
+use crate::sim_body::DeviceChoice;
 use exercise::{AttemptSummary, XrExercise};
 use frame_loop::{LoopOptions, LoopOutcome, run_loop};
 use script::{HeadsetScript, Pacing, RightTrack};
@@ -143,8 +144,49 @@ pub struct XrReport {
     pub attempts: Vec<AttemptSummary>,
 }
 
-/// Run `incise xr`. No usable runtime: an [`XrUnavailable`] error (exit 2).
-pub fn run(opts: &XrOptions) -> Result<XrReport> {
+/// Run `incise xr`; the session's summary line. A scene of another method than XPBD runs
+/// a [`method_session`] (no exercise). No usable runtime: an [`XrUnavailable`] error
+/// (exit 2).
+pub fn run(opts: &XrOptions) -> Result<String> {
+    if opts.exercise.is_none() {
+        let scene = crate::scene::load_scene(&opts.scene)?;
+        if !matches!(scene.model, crate::scene::ModelChoice::Xpbd) {
+            return run_method(opts);
+        }
+    }
+    run_xpbd(opts).map(|r| r.summary())
+}
+
+/// `incise xr` for a Nakao or rheology scene, on the simulated headset or the runtime's.
+fn run_method(opts: &XrOptions) -> Result<String> {
+    if let Some(script) = &opts.simulated {
+        return method_session::run_simulated(&opts.scene, script, &opts.out);
+    }
+    let mut session = open_session(&opts.scene)?;
+    let body = crate::pictures::drawn_body::DrawnBody::open(&opts.scene)?;
+    let (lo, hi) = body.render.mesh.rest_bounds();
+    method_session::run_on(
+        &mut session,
+        &opts.scene,
+        body,
+        Tray::for_bounds(lo, hi),
+        &opts.out,
+    )
+}
+
+/// The OpenXR session, or [`XrUnavailable`] naming what is missing.
+fn open_session(scene: &Path) -> Result<XrSession> {
+    XrSession::open().map_err(|e| {
+        if e.is_unavailable() {
+            anyhow::Error::new(XrUnavailable(unavailable::message(&e, scene)))
+        } else {
+            anyhow::Error::new(e).context("starting the OpenXR session")
+        }
+    })
+}
+
+/// `incise xr` for an XPBD scene (and exercises).
+fn run_xpbd(opts: &XrOptions) -> Result<XrReport> {
     let mut exercise = opts
         .exercise
         .as_ref()
@@ -157,13 +199,7 @@ pub fn run(opts: &XrOptions) -> Result<XrReport> {
     match &opts.simulated {
         Some(script) => run_simulated(opts, &scene, script, exercise.as_mut()),
         None => {
-            let mut session = XrSession::open().map_err(|e| {
-                if e.is_unavailable() {
-                    anyhow::Error::new(XrUnavailable(unavailable::message(&e, &scene)))
-                } else {
-                    anyhow::Error::new(e).context("starting the OpenXR session")
-                }
-            })?;
+            let mut session = open_session(&scene)?;
             eprintln!("xr: backdrop {:?}", session.backdrop());
             let dev = session.device().clone();
             let mode = sim_mode::resolve(opts.sim, exercise.is_some(), false)?;

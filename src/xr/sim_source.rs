@@ -15,7 +15,7 @@ use super::in_frame::InFrameSim;
 use super::sim_state::{Advanced, CommandStamp, SimState, ToolCommand};
 use super::sim_thread::SimLink;
 use super::xr_body::XrBody;
-use crate::screenshots::stress_scale;
+use crate::pictures::screenshots::stress_scale;
 
 /// The display side of the simulation thread.
 pub struct ThreadSim<'s> {

@@ -11,7 +11,7 @@ use incise_xr::BodyState;
 use incise_xr::frame::pinned_nodes;
 
 use super::xr_body::XrBody;
-use crate::screenshots::stress_scale;
+use crate::pictures::screenshots::stress_scale;
 
 /// The display's orders for the simulation, newest wins.
 #[derive(Debug, Clone, Copy, PartialEq)]

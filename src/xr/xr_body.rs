@@ -13,9 +13,9 @@ use incise_sim::{Material, Solver};
 use incise_xr::RenderDevice;
 use incise_xr::frame::pinned_nodes;
 
-use crate::body::{Body, DeviceChoice};
+use crate::pictures::screenshots::place_on;
 use crate::scene::{BuiltScene, Scene, build_scene, load_scene};
-use crate::screenshots::place_on;
+use crate::sim_body::{Body, DeviceChoice};
 
 /// A bounding box: its min and max corners (sim world, m).
 pub type CutBox = ([f32; 3], [f32; 3]);

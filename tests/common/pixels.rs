@@ -77,7 +77,7 @@ pub fn scene_view(scene: &str, w: u32, h: u32) -> (View, Vec3, Vec3) {
     let built = incise::scene::build_scene(&s, &path, None).unwrap();
     let mesh = built.solver.mesh();
     let (lo, hi) = mesh.rest_bounds();
-    let view = incise::screenshots::default_camera(mesh).view(w as f32 / h as f32);
+    let view = incise::pictures::screenshots::default_camera(mesh).view(w as f32 / h as f32);
     (view, lo, hi)
 }
 

@@ -14,8 +14,8 @@ use serde::Serialize;
 
 use incise_sim::gpu::{GpuContext, GpuSolver};
 
-use crate::body::{Body, DeviceChoice};
 use crate::scene::{build_scene, load_scene};
+use crate::sim_body::{Body, DeviceChoice};
 
 /// Options of `incise soak`.
 #[derive(Debug, Clone)]

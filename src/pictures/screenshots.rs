@@ -15,8 +15,8 @@ use incise_xr::{
     BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View,
 };
 
-use crate::body::{Body, DeviceChoice, auto_device};
 use crate::exercise::PlanDecal;
+use crate::sim_body::{Body, DeviceChoice, auto_device};
 
 /// An image size `WIDTHxHEIGHT` given on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -152,7 +152,7 @@ impl Screenshots {
     pub fn with_tool(mut self, tool: &incise_scalpel::Tool) -> Self {
         self.offscreen
             .renderer
-            .set_tool_mesh(&crate::tool_view::tool_mesh(tool));
+            .set_tool_mesh(&crate::pictures::tool_view::tool_mesh(tool));
         self.draw_tool = true;
         self
     }
@@ -180,7 +180,7 @@ impl Screenshots {
     pub fn image(&mut self, body: &Body) -> Result<RgbaImage> {
         let solver = body.solver();
         if self.draw_tool {
-            self.settings.tool = crate::tool_view::tool_state(solver);
+            self.settings.tool = crate::pictures::tool_view::tool_state(solver);
         }
         self.settings.lines = self
             .decal

@@ -10,8 +10,8 @@ use anyhow::{Context, Result};
 use incise_sim::xpbd::CpuKernel;
 use serde::Serialize;
 
-use crate::body::{Body, DeviceChoice};
-use crate::soak::percentile;
+use crate::bench::soak::percentile;
+use crate::sim_body::{Body, DeviceChoice};
 
 /// The realtime figures of one device.
 #[derive(Debug, Clone, Serialize)]

@@ -2,6 +2,10 @@
 //! 34k-tet intestine, serial and with all threads on the CPU, or on the GPU; optionally
 //! the intestine scaling series (≈34k, 140k, 550k, 1.1M tets); plus memory.
 
+pub mod realtime;
+pub mod render;
+pub mod soak;
+
 use std::time::Instant;
 
 use anyhow::Result;
@@ -11,8 +15,8 @@ use incise_sim::xpbd::{stiffness_number, substeps_needed};
 use incise_sim::{Material, RawMesh, Solver, SolverParams, TetMesh};
 use serde::Serialize;
 
-use crate::body::{Body, DeviceChoice};
 use crate::cli::BenchCase;
+use crate::sim_body::{Body, DeviceChoice};
 
 /// Substeps per benchmark frame.
 pub const BENCH_SUBSTEPS: u32 = 10;
@@ -121,7 +125,7 @@ pub fn run(
         }
     }
     let report = BenchReport {
-        machine: machine(),
+        machine: crate::provenance::machine(),
         results,
     };
     match output {
@@ -374,19 +378,4 @@ fn peak_mib() -> f64 {
                 .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
         })
         .map_or(0.0, |kb| kb / 1024.0)
-}
-
-/// CPU model name and logical core count.
-pub fn machine() -> String {
-    let model = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    format!("{model}, {cores} logical cores")
 }

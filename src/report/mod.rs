@@ -4,11 +4,17 @@
 //! releases, the edge models (mass-spring, rheology) displacement, volume and energy. A
 //! quantity a model does not compute is left out, never written as NaN or null.
 
+pub mod localisation;
+pub mod plot;
+
 use std::path::Path;
 
 use anyhow::{Context, Result};
 use incise_sim::xpbd::FrameStats;
 use serde::Serialize;
+
+use crate::scene::Scene;
+use crate::sim_body::method::Method;
 
 /// One frame's line in the report.
 #[derive(Debug, Clone, Serialize)]
@@ -118,6 +124,8 @@ pub struct Report {
     pub scene_file: String,
     /// Simulation model: "xpbd", "mass-spring" or "rheology".
     pub model: String,
+    /// Simulation method: "xpbd", "nakao" or "rheology" (every report has this schema).
+    pub method: Method,
     /// "completed" or "failed".
     pub status: String,
     /// The error that stopped the run, if any.
@@ -150,12 +158,15 @@ pub struct Report {
     /// Materials per region and dent figures of a rheology scene.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rheology: Option<RheologyInfo>,
+    /// What the Nakao cutter did to the mesh: added nodes and tets, the wound's opening.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nakao: Option<NakaoInfo>,
     /// Loop rate and tool force of a haptic-rate run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub haptic: Option<HapticInfo>,
     /// Levels, free nodes and loop-time split over the frames of a mass-spring run.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub localisation: Option<crate::loop_report::LocalisationInfo>,
+    pub localisation: Option<localisation::LocalisationInfo>,
 }
 
 /// Mesh figures for the report.
@@ -225,6 +236,22 @@ pub struct RheologyInfo {
     pub residual_dent_m: f64,
 }
 
+/// The Nakao cutter's result (PHYSICS.md §2.3–2.4, §2.6): what cutting added to the
+/// mesh and how far the wound opened under the tension.
+#[derive(Debug, Clone, Serialize)]
+pub struct NakaoInfo {
+    /// Nodes the cut added (duplicated and subdivision nodes).
+    pub nodes_added: usize,
+    /// Tets the cut added (subdivision).
+    pub tets_added: usize,
+    /// Area of the cut surfaces at the end, m².
+    pub cut_area_m2: f64,
+    /// Mean distance between the two copies of every node the cut duplicated, m (absent
+    /// when nothing was cut).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub opening_width_m: Option<f64>,
+}
+
 /// What the haptic-rate loop did (PHYSICS.md §2.6), all measured, none assumed.
 #[derive(Debug, Clone, Serialize)]
 pub struct HapticInfo {
@@ -253,6 +280,40 @@ pub struct HapticInfo {
 }
 
 impl Report {
+    /// A running report of `scene` (file `path`) for model name and method `model`, with
+    /// its mesh figures and solver settings; the rest is filled by the body and the run.
+    pub fn begin(
+        scene: &Scene,
+        path: &Path,
+        model: (&str, Method),
+        mesh: MeshInfo,
+        solver: incise_sim::SolverParams,
+    ) -> Report {
+        Report {
+            scene: scene.name.clone(),
+            scene_file: path.display().to_string(),
+            model: model.0.into(),
+            method: model.1,
+            status: "running".into(),
+            error: None,
+            mesh,
+            material: None,
+            solver,
+            threads: 1,
+            device: "cpu".into(),
+            device_choice: None,
+            tool: None,
+            warnings: Vec::new(),
+            released_tets: Vec::new(),
+            frames: Vec::new(),
+            snapshots: Vec::new(),
+            rheology: None,
+            nakao: None,
+            haptic: None,
+            localisation: None,
+        }
+    }
+
     /// Write as pretty JSON, atomically (temp file + rename).
     pub fn write(&self, path: &Path) -> Result<()> {
         let json = serde_json::to_vec_pretty(self)?;
@@ -286,6 +347,15 @@ impl Report {
                         r.max_dent_m * 1e3,
                         r.residual_dent_m * 1e3
                     );
+                }
+                if let Some(n) = &self.nakao {
+                    line += &format!(
+                        ", cut added {} nodes and {} tets",
+                        n.nodes_added, n.tets_added
+                    );
+                    if let Some(w) = n.opening_width_m {
+                        line += &format!(", wound open {:.2} mm", w * 1e3);
+                    }
                 }
                 if let Some(l) = &self.localisation {
                     line += &format!(

@@ -15,8 +15,8 @@ use incise_sim::{Material, Solver, SolverParams, TetMesh};
 use incise_xr::{Camera, OffscreenRenderer, RenderDevice, RenderSettings, UncutBody, View};
 use serde::Serialize;
 
-use crate::body::{DeviceChoice, auto_device};
 use crate::cli::BenchCase;
+use crate::sim_body::{DeviceChoice, auto_device};
 
 /// The GPU body's material: it is not stepped (only its buffers are read); soft enough
 /// for the default substeps on every benchmark mesh, so the solver accepts it.
@@ -238,7 +238,7 @@ pub fn run(
     }
     let report = RenderBenchReport {
         adapter: dev.describe(),
-        machine: crate::bench::machine(),
+        machine: crate::provenance::machine(),
         positions_from: match device {
             DeviceChoice::Gpu => "gpu".into(),
             _ => "cpu".into(),

@@ -9,7 +9,7 @@ use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
 /// The embedded font (Bitstream Vera licence, see `assets/fonts/README.md`).
-const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Line colours, in series order (repeats after eight).
 const PALETTE: [RGBColor; 8] = [

@@ -8,9 +8,10 @@ use incise_sim::gpu::{GpuContext, GpuSolver};
 use incise_sim::xpbd::{FrameStats, SolverError};
 
 /// Where the solver runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum DeviceChoice {
     /// The GPU when an adapter exists, else the CPU with a one-line notice.
+    #[default]
     Auto,
     /// The CPU reference solver (rayon).
     Cpu,

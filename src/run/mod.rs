@@ -1,0 +1,69 @@
+//! `incise run`: the headless runner. Opens a scene's body (any method), steps it in the
+//! one frame loop, writes report.json, .vtu snapshots and a .pvd collection; on a solver
+//! failure the output written so far is kept and the report says what failed.
+
+pub mod ending;
+pub mod frame_loop;
+pub mod options;
+
+pub use ending::{RunEnd, finish};
+pub use options::{CHECKPOINT_FRAMES, RunOptions, RunOutcome};
+
+use anyhow::{Result, bail};
+
+use crate::scene::{ModelChoice, load_scene};
+use crate::sim_body::{OpenOptions, open};
+use frame_loop::FrameLoop;
+
+/// Run a scene headless: open its body, run the frames, let the body fill in its
+/// end-of-run figures, and end as every run does. A solver failure is returned as `Err`
+/// after the report and the snapshots so far have been written.
+pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
+    let scene = load_scene(&opts.scene)?;
+    refuse_xpbd_only_options(&scene.model, opts)?;
+    let (body, report) = open(&scene, &opts.scene, &open_options(opts))?;
+    let frames = opts
+        .frames
+        .unwrap_or_else(|| (scene.duration as f64 / body.frame_dt()).round().max(1.0) as u64);
+    let (mut body, mut report, stopped) =
+        FrameLoop::new(body, report, opts, frames)?.run(frames)?;
+    let closing = body.finish(&mut report)?;
+    if let Some(line) = closing.filter(|_| !opts.quiet && stopped.is_none()) {
+        eprintln!("{line}");
+    }
+    finish(report, opts.out.join("report.json"), stopped, opts)
+}
+
+/// What of `opts` the body is opened with.
+fn open_options(opts: &RunOptions) -> OpenOptions {
+    OpenOptions {
+        threads: opts.threads,
+        device: opts.device,
+        stroke: opts.stroke.clone(),
+        haptic_rate: opts.haptic_rate,
+        quiet: opts.quiet,
+    }
+}
+
+/// Strokes drive and record the XPBD scalpel only: refused for the other methods, whose
+/// tools follow their own scripts.
+fn refuse_xpbd_only_options(model: &ModelChoice, opts: &RunOptions) -> Result<()> {
+    let method = match model {
+        ModelChoice::Xpbd => return Ok(()),
+        ModelChoice::MassSpring(_) => "MassSpring",
+        ModelChoice::Rheology(_) => "Rheology",
+    };
+    for (given, flag) in [
+        (opts.stroke.is_some(), "--stroke"),
+        (opts.record_stroke.is_some(), "--record-stroke"),
+    ] {
+        if given {
+            bail!(
+                "{}: {flag} drives the XPBD scalpel; this scene's model is {method}, whose \
+                 tool follows model.stroke or model.indenter",
+                opts.scene.display()
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,183 @@
+//! The interface every simulation method's body implements: advance one frame with the
+//! tool, the surface to draw with the method's own heat-map quantity, the tool force for
+//! haptics, per-frame statistics for the report, VTU snapshots, guards and rollback.
+//! `incise run`'s one frame loop (`crate::run`) drives any body through it.
+
+use std::path::Path;
+
+pub use super::method::Method;
+use crate::exercise::PlanDecal;
+use crate::pictures::screenshots::{ImageSize, Screenshots};
+use crate::report::{FrameData, Report};
+use glam::Vec3;
+use incise_sim::contact::ToolPose;
+
+/// What moves the tool in the frame being stepped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ToolInput {
+    /// The body's own script: the scene's stroke (XPBD), blade stroke (Nakao) or
+    /// indenter schedule (rheology).
+    Script,
+    /// A hand (mouse, controller, recorded stroke) has the tool at `pose` by the end of
+    /// the frame; `engaged`: the trigger or button that makes it cut, grab or press.
+    Hand {
+        /// Tool pose at the end of the frame.
+        pose: ToolPose,
+        /// Whether the tool acts (cuts, grabs, presses).
+        engaged: bool,
+    },
+}
+
+/// The name and unit of the per-vertex quantity a method colours its heat map with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Quantity {
+    /// What it is, e.g. "von Mises stress", "spring tension", "edge strain".
+    pub name: &'static str,
+    /// Its unit, e.g. "Pa", "N", "1".
+    pub unit: &'static str,
+}
+
+/// The surface of a body as it is to be drawn.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Surface {
+    /// Vertex positions (the body's nodes), m.
+    pub positions: Vec<Vec3>,
+    /// Surface triangles of the uncut skin (outward wound, vertex indices).
+    pub triangles: Vec<[u32; 3]>,
+    /// Triangles of the cut surface (outward wound, vertex indices).
+    pub cut_triangles: Vec<[u32; 3]>,
+    /// The heat-map quantity per vertex (in [`Surface::quantity`]'s unit).
+    pub scalar: Vec<f32>,
+    /// What [`Surface::scalar`] is.
+    pub quantity: Option<Quantity>,
+}
+
+/// The body as tets for the renderer (which draws a tet mesh's skin and colours the
+/// heat map per tet).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TetView {
+    /// Node positions now, m.
+    pub positions: Vec<Vec3>,
+    /// The tets (node indices); they change when a method cuts by remodelling.
+    pub tets: Vec<[u32; 4]>,
+    /// The heat-map quantity per tet (mean over its nodes or the method's own per-tet
+    /// value).
+    pub per_tet: Vec<f32>,
+    /// What [`TetView::per_tet`] is.
+    pub quantity: Option<Quantity>,
+}
+
+/// Why a frame could not be stepped; the body is left at its last completed frame.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// The GPU device was lost; [`SimBody::into_cpu`] continues the run on the CPU.
+    #[error("{0}")]
+    DeviceLost(String),
+    /// The solver failed (non-finite state, inverted tets, divergence).
+    #[error("{0}")]
+    Failed(String),
+}
+
+/// A fault a test injects before a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// A NaN velocity on the first free node: the next frame must fail and roll back.
+    Nan,
+    /// The GPU device is lost.
+    DeviceLoss,
+}
+
+/// How a scene's body is opened (the run's, preview's or headset's choices).
+#[derive(Debug, Clone, Default)]
+pub struct OpenOptions {
+    /// Solver threads (default: the scene's, 0 = all cores); XPBD only.
+    pub threads: Option<usize>,
+    /// Where the XPBD solver runs.
+    pub device: crate::sim_body::xpbd_device::DeviceChoice,
+    /// Drive the scene's tool with this stroke file instead of the scene's stroke (XPBD).
+    pub stroke: Option<std::path::PathBuf>,
+    /// Run a Nakao scene's local loop on its own thread at this rate, Hz (PHYSICS.md §2.6).
+    pub haptic_rate: Option<f64>,
+    /// Print no notices.
+    pub quiet: bool,
+}
+
+/// A simulated body of one method, stepped frame by frame.
+pub trait SimBody {
+    /// Which method this body runs.
+    fn method(&self) -> Method;
+
+    /// The frame length, s.
+    fn frame_dt(&self) -> f64;
+
+    /// Simulated time at the end of the last completed frame, s.
+    fn time(&self) -> f64;
+
+    /// Advance one frame with the tool as `tool` says; the frame's statistics. On an
+    /// error the body stays at its last completed frame (guarded and rolled back).
+    fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError>;
+
+    /// Where the tool is at the end of the last frame (`None`: no tool).
+    fn tool_pose(&self) -> Option<ToolPose>;
+
+    /// Force of the tissue on the tool in the last frame, N (`None`: no tool).
+    fn tool_force(&self) -> Option<Vec3>;
+
+    /// The surface to draw, with the method's heat-map quantity per vertex.
+    fn surface(&self) -> Surface;
+
+    /// The body as tets for the renderer, with the heat-map quantity per tet.
+    fn tet_view(&self) -> TetView;
+
+    /// Write the body's state as a `.vtu` file at `path`.
+    fn write_vtu(&self, path: &Path) -> anyhow::Result<()>;
+
+    /// The figures the progress line shows for `frame` (the method's own).
+    fn progress_line(&self, frame: &FrameData) -> String;
+
+    /// Where the body runs: "cpu", the GPU adapter, or the method's CPU loop.
+    fn device(&self) -> String;
+
+    /// GPU kernel time of the last frame, ms, where the body runs on a GPU with timestamps.
+    fn gpu_frame_ms(&self) -> Option<f64> {
+        None
+    }
+
+    /// After [`StepError::DeviceLost`]: the body on the CPU from its last completed frame
+    /// (a body that runs on the CPU already stays as it is).
+    fn into_cpu(self: Box<Self>) -> Box<dyn SimBody>;
+
+    /// Inject `fault` (testing aid); an error when the method has no such fault.
+    fn inject(&mut self, fault: Fault) -> anyhow::Result<()>;
+
+    /// Whether the body's state is on this thread between frames, so that a snapshot can
+    /// be written (false: a haptic thread holds it until the run ends).
+    fn holds_state(&self) -> bool {
+        true
+    }
+
+    /// Fill the report's end-of-run figures (counts after cutting, released tets, the
+    /// method's own sections); called once, after the last frame. Returns the line the
+    /// run prints at its end, where the method has one.
+    fn finish(&mut self, report: &mut Report) -> anyhow::Result<Option<String>>;
+
+    /// An offscreen renderer of `size` for this body with its tool and `decal` (an
+    /// exercise's plan) drawn; an error for a method the renderer cannot draw yet.
+    fn screenshots(
+        &self,
+        size: ImageSize,
+        decal: Option<&PlanDecal>,
+    ) -> anyhow::Result<Screenshots> {
+        let _ = (size, decal);
+        anyhow::bail!(
+            "offscreen pictures draw XPBD bodies only so far; this body's method is {}",
+            self.method().name()
+        )
+    }
+
+    /// Draw the body now with `shots` (from [`SimBody::screenshots`]) into the PNG `path`.
+    fn screenshot(&self, shots: &mut Screenshots, path: &Path) -> anyhow::Result<()> {
+        let _ = (shots, path);
+        anyhow::bail!("{} bodies have no offscreen pictures", self.method().name())
+    }
+}

@@ -1,0 +1,24 @@
+//! The simulated body of each method behind one interface ([`SimBody`]): the XPBD solver
+//! on its device, the Nakao mass-spring cutter (frame by frame or at a haptic rate) and
+//! the three-element rheological body, side by side; [`open`] opens a scene's.
+
+pub mod interface;
+pub mod method;
+pub mod nakao;
+pub mod nakao_blade;
+pub mod nakao_haptic;
+pub mod nakao_open;
+pub mod nakao_surface;
+pub mod open;
+pub mod rheology;
+pub mod rheology_open;
+pub mod vertex_field;
+pub mod xpbd;
+pub mod xpbd_device;
+
+pub use interface::{
+    Fault, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
+};
+pub use method::Method;
+pub use open::open;
+pub use xpbd_device::{Body, DeviceChoice, auto_device};

@@ -1,0 +1,401 @@
+//! The Nakao tension mass-spring cutter behind [`SimBody`], frame by frame (PHYSICS.md
+//! §2.1–2.5): each frame advances the blade (cutting: remodelling and adaptive
+//! subdivision), then takes the frame's explicit steps on the whole mesh or on the nodes
+//! the localisation frees around the blade: a fixed level d, or the refresh-rate manager,
+//! which picks the level each frame from the time the last one took. Every frame records
+//! the level, the free nodes and the loop-time split. A frame that leaves a non-finite
+//! position is rolled back to the last completed one.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use glam::{DVec3, Quat, Vec3};
+use incise_sim::contact::ToolPose;
+use incise_sim::io::{VtuFrame, write_vtu};
+use incise_sim::mass_spring::{
+    HapticConfig, LocalLoop, LocalLoopParams, MassSpringModel, SystemClock,
+};
+use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, opening_width};
+use incise_sim::nakao_cut::{BladePose, Cutter};
+
+use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
+use super::nakao_blade::Blade;
+use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};
+use crate::report::localisation::{LocalisationInfo, LoopSample, LoopSplit};
+use crate::report::{EdgeFrameStats, FrameData, NakaoInfo, Report};
+use crate::scene::{Localisation, MassSpringScene};
+
+/// The heat map of a Nakao body: the spring tension at each node.
+const TENSION: Quantity = Quantity {
+    name: "spring tension",
+    unit: "N",
+};
+
+/// A Nakao body stepped frame by frame, with its blade and localisation.
+pub struct NakaoBody {
+    model: MassSpringModel,
+    /// The model after the last completed frame (what a failed frame rolls back to).
+    last_good: MassSpringModel,
+    cutter: Cutter,
+    cutting: bool,
+    blade: Blade,
+    /// Where the blade edge was at the end of the last frame.
+    pose: Option<BladePose>,
+    local: Option<LocalLoop>,
+    localisation: Localisation,
+    samples: Vec<LoopSample>,
+    forces: Vec<DVec3>,
+    frame_dt: f64,
+    frame: u64,
+    total_volume: f64,
+    /// Force of the tissue on a hand's tool in the last frame (`None`: scripted blade).
+    force: Option<DVec3>,
+}
+
+impl NakaoBody {
+    /// The body of `model` with the scene's stroke, cut settings and localisation, stepped
+    /// every `frame_dt` seconds.
+    pub fn new(model: MassSpringModel, ms: &MassSpringScene, frame_dt: f64) -> NakaoBody {
+        let total_volume = (0..model.tet_count())
+            .map(|t| model.reference_volume(t))
+            .sum();
+        NakaoBody {
+            last_good: model.clone(),
+            model,
+            cutter: Cutter::new(ms.cut.clone()),
+            cutting: false,
+            blade: Blade::of_stroke(ms.stroke.clone()),
+            pose: None,
+            local: local_loop(ms.localisation),
+            localisation: ms.localisation,
+            samples: Vec::new(),
+            forces: Vec::new(),
+            frame_dt,
+            frame: 0,
+            total_volume,
+            force: None,
+        }
+    }
+
+    /// The model as of the last completed frame.
+    pub fn model(&self) -> &MassSpringModel {
+        &self.model
+    }
+
+    /// Move the blade as `tool` says and cut where it is engaged; the cut's ms.
+    // PHYSICS.md §2.3–2.4: the cutter remodels and subdivides along the blade's sweep.
+    fn cut(&mut self, tool: &ToolInput) -> f64 {
+        let Some((pose, engaged, begin)) = self.blade.at(tool, self.model.time(), self.pose) else {
+            return 0.0;
+        };
+        self.pose = Some(pose);
+        if engaged && !self.cutting {
+            self.cutter.begin(&self.model, begin);
+            self.cutting = true;
+        }
+        if !self.cutting {
+            return 0.0;
+        }
+        let ms = self.cutter.advance(&mut self.model, pose).ms;
+        if !engaged {
+            self.cutter.end();
+            self.cutting = false;
+        }
+        ms
+    }
+
+    /// The frame's `steps` explicit steps of `dt`, localised around the blade when the
+    /// scene asks for it; the localisation figures.
+    // PHYSICS.md §2.1 (eq. 2) and §2.5 (localisation, refresh-rate manager).
+    fn integrate(&mut self, dt: f64, steps: u32, cut_ms: f64) -> LoopSample {
+        let tip = self.pose.map(|p| (p.heel + p.tip) * 0.5);
+        if let (Some(l), Some(tip)) = (&mut self.local, tip) {
+            let s = l.frame(&mut self.model, tip, dt, steps);
+            return LoopSample {
+                level: Some(s.level()),
+                free_nodes: s.free_nodes,
+                split: LoopSplit {
+                    localise_ms: s.localise_ms,
+                    force_ms: s.force_ms,
+                    integrate_ms: s.integrate_ms,
+                    cut_ms,
+                },
+            };
+        }
+        let (force_ms, integrate_ms) = whole_frame(&mut self.model, dt, steps, &mut self.forces);
+        LoopSample {
+            level: None,
+            free_nodes: self.model.node_count(),
+            split: LoopSplit {
+                localise_ms: 0.0,
+                force_ms,
+                integrate_ms,
+                cut_ms,
+            },
+        }
+    }
+
+    /// The report's statistics of the frame just stepped.
+    fn stats(&self, steps: u32, wall_ms: f64, sample: &LoopSample) -> EdgeFrameStats {
+        let m = &self.model;
+        let volume: f64 = (0..m.tet_count()).map(|t| m.current_volume(t)).sum();
+        EdgeFrameStats {
+            frame: self.frame,
+            sim_time: m.time(),
+            substeps: steps as u64,
+            volume_ratio: volume / self.total_volume,
+            max_displacement: max_displacement(m.reference_positions(), m.positions()),
+            kinetic_energy: Some(m.kinetic_energy()),
+            solve_ms: Some(wall_ms),
+            level: sample.level,
+            free_nodes: Some(sample.free_nodes),
+            localise_ms: Some(sample.split.localise_ms),
+            force_ms: Some(sample.split.force_ms),
+            integrate_ms: Some(sample.split.integrate_ms),
+            cut_ms: Some(sample.split.cut_ms),
+            ..EdgeFrameStats::default()
+        }
+    }
+
+    /// A hand's tool point (the middle of the blade edge) coupled to the nearest node
+    /// within the contact radius by the haptic loop's virtual spring (PHYSICS.md §2.6),
+    /// for the frame; the force of the tissue on the tool.
+    fn couple(&mut self) -> DVec3 {
+        let Some(p) = self.pose else {
+            return DVec3::ZERO;
+        };
+        let tip = (p.heel + p.tip) * 0.5;
+        let config = HapticConfig::default();
+        let near = self.model.nearest_node(tip).filter(|&n| {
+            (self.model.positions()[n as usize] - tip).length() <= config.contact_radius
+        });
+        let Some(n) = near else {
+            return DVec3::ZERO;
+        };
+        let f = config.coupling * (tip - self.model.positions()[n as usize]);
+        self.model.set_external_force(n, f);
+        -f
+    }
+
+    /// Go back to the last completed frame, the blade lifted.
+    fn roll_back(&mut self) {
+        self.model = self.last_good.clone();
+        if self.cutting {
+            self.cutter.end();
+            self.cutting = false;
+        }
+    }
+}
+
+impl SimBody for NakaoBody {
+    fn method(&self) -> Method {
+        Method::Nakao
+    }
+
+    fn frame_dt(&self) -> f64 {
+        self.frame_dt
+    }
+
+    fn time(&self) -> f64 {
+        self.model.time()
+    }
+
+    fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError> {
+        let t0 = Instant::now();
+        let cut_ms = self.cut(tool);
+        self.force = matches!(tool, ToolInput::Hand { .. }).then(|| self.couple());
+        let steps = (self.frame_dt / self.model.stable_dt()).ceil().max(1.0) as u32;
+        let sample = self.integrate(self.frame_dt / steps as f64, steps, cut_ms);
+        self.model.clear_external_forces();
+        if let Some(i) = self.model.positions().iter().position(|p| !p.is_finite()) {
+            self.roll_back();
+            return Err(StepError::Failed(format!(
+                "frame {}: node {i} has a non-finite position; rolled back to the last \
+                 completed frame",
+                self.frame
+            )));
+        }
+        let wall_ms = t0.elapsed().as_secs_f64() * 1e3;
+        self.samples.push(sample);
+        let stats = self.stats(steps, wall_ms, &sample);
+        self.frame += 1;
+        self.last_good.clone_from(&self.model);
+        Ok(FrameData::Edges(stats))
+    }
+
+    fn tool_pose(&self) -> Option<ToolPose> {
+        self.pose.map(|p| ToolPose {
+            position: p.tip.as_vec3(),
+            rotation: Quat::IDENTITY,
+        })
+    }
+
+    fn tool_force(&self) -> Option<Vec3> {
+        self.force.map(|f| f.as_vec3())
+    }
+
+    fn surface(&self) -> Surface {
+        surface_of(&self.model)
+    }
+
+    fn tet_view(&self) -> TetView {
+        tet_view_of(&self.model)
+    }
+
+    fn write_vtu(&self, path: &Path) -> Result<()> {
+        write_model_vtu(&self.model, path)
+    }
+
+    fn progress_line(&self, frame: &FrameData) -> String {
+        match frame {
+            FrameData::Edges(s) => format!(
+                "{} nodes, max displacement {:.2} mm",
+                self.model.node_count(),
+                s.max_displacement * 1e3
+            ),
+            FrameData::Xpbd(_) => String::new(),
+        }
+    }
+
+    fn device(&self) -> String {
+        "cpu (mass-spring)".into()
+    }
+
+    fn into_cpu(self: Box<Self>) -> Box<dyn SimBody> {
+        self
+    }
+
+    fn inject(&mut self, fault: Fault) -> Result<()> {
+        match fault {
+            Fault::Nan => {
+                let free =
+                    (0..self.model.node_count()).find(|&i| !self.model.fixed_axes(i).is_pinned());
+                if let Some(i) = free {
+                    self.model.set_position(i, DVec3::NAN);
+                }
+                Ok(())
+            }
+            Fault::DeviceLoss => bail!("the Nakao method runs on the CPU: there is no GPU to lose"),
+        }
+    }
+
+    fn finish(&mut self, report: &mut Report) -> Result<Option<String>> {
+        if self.cutting {
+            self.cutter.end();
+            self.cutting = false;
+        }
+        let budget = match self.localisation {
+            Localisation::Budget(b) => Some(b),
+            _ => None,
+        };
+        report.localisation =
+            LocalisationInfo::of(self.localisation.label(), budget, &self.samples);
+        Ok(Some(counts_into(&self.model, report, self.frame)))
+    }
+}
+
+/// The surface of `m` with its spring tension per node.
+pub fn surface_of(m: &MassSpringModel) -> Surface {
+    Surface {
+        positions: m.positions().iter().map(|p| p.as_vec3()).collect(),
+        triangles: surface_triangles(m),
+        cut_triangles: cut_triangles(m),
+        scalar: tension_at_nodes(m),
+        quantity: Some(TENSION),
+    }
+}
+
+/// `m` as tets with the mean spring tension of each tet's nodes.
+pub fn tet_view_of(m: &MassSpringModel) -> TetView {
+    let tension = tension_at_nodes(m);
+    TetView {
+        positions: m.positions().iter().map(|p| p.as_vec3()).collect(),
+        tets: m.tets().to_vec(),
+        per_tet: m
+            .tets()
+            .iter()
+            .map(|t| t.iter().map(|&n| tension[n as usize]).sum::<f32>() / 4.0)
+            .collect(),
+        quantity: Some(TENSION),
+    }
+}
+
+/// Write `m` as a `.vtu` at `path`: per tet its cut faces, per node velocity and tension.
+pub fn write_model_vtu(m: &MassSpringModel, path: &Path) -> Result<()> {
+    let positions: Vec<Vec3> = m.positions().iter().map(|p| p.as_vec3()).collect();
+    let velocity: Vec<Vec3> = m.velocities().iter().map(|v| v.as_vec3()).collect();
+    let cut: Vec<f32> = m
+        .tet_cut_faces()
+        .iter()
+        .map(|f| f.count_ones() as f32)
+        .collect();
+    let tension = tension_at_nodes(m);
+    let frame = VtuFrame {
+        positions: &positions,
+        tets: m.tets(),
+        cell_scalars: vec![("cut_faces", &cut)],
+        point_vectors: vec![("velocity", &velocity)],
+        point_scalars: vec![("tension", &tension)],
+    };
+    Ok(write_vtu(path, &frame)?)
+}
+
+/// Put `m`'s counts after cutting into the report's mesh figures and its Nakao section
+/// (added nodes and tets against the report's opening counts, the wound's opening);
+/// the closing line.
+pub fn counts_into(m: &MassSpringModel, report: &mut Report, frames: u64) -> String {
+    let after = counts(m);
+    report.nakao = Some(NakaoInfo {
+        nodes_added: after.nodes.saturating_sub(report.mesh.nodes),
+        tets_added: after.tets.saturating_sub(report.mesh.tets),
+        cut_area_m2: cut_surface_area(m),
+        opening_width_m: opening_width(m, DVec3::ZERO, f64::INFINITY),
+    });
+    report.mesh.nodes = after.nodes;
+    report.mesh.tets = after.tets;
+    report.mesh.skin_vertices = after.nodes;
+    report.mesh.skin_triangles = after.triangles;
+    format!(
+        "mass-spring: {} nodes, {} tets, {} edges after {frames} frames",
+        after.nodes, after.tets, after.edges
+    )
+}
+
+/// The localised loop of a scene's setting (`None` for `Whole`).
+fn local_loop(l: Localisation) -> Option<LocalLoop> {
+    let params = match l {
+        Localisation::Whole => return None,
+        Localisation::Level(d) => LocalLoopParams {
+            max_level: d,
+            ..LocalLoopParams::default()
+        },
+        Localisation::Budget(ms) => LocalLoopParams {
+            budget_ms: Some(ms),
+            max_level: u32::MAX,
+            ..LocalLoopParams::default()
+        },
+    };
+    Some(LocalLoop::new(params, SystemClock::default()))
+}
+
+/// `steps` steps of `dt` on every node, timed by phase: (force ms, integrate ms).
+// PHYSICS.md §2.1, eqs. 1–2.
+fn whole_frame(
+    model: &mut MassSpringModel,
+    dt: f64,
+    steps: u32,
+    forces: &mut Vec<DVec3>,
+) -> (f64, f64) {
+    let all: Vec<u32> = (0..model.node_count() as u32).collect();
+    let (mut force_ms, mut integrate_ms) = (0.0, 0.0);
+    for _ in 0..steps {
+        let a = Instant::now();
+        model.gather_forces(&all, forces);
+        let b = Instant::now();
+        model.integrate_nodes(dt, &all, forces);
+        force_ms += (b - a).as_secs_f64() * 1e3;
+        integrate_ms += b.elapsed().as_secs_f64() * 1e3;
+    }
+    (force_ms, integrate_ms)
+}

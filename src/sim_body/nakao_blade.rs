@@ -1,0 +1,122 @@
+//! The Nakao cutter's blade (PHYSICS.md §2.3): a straight cutting edge from heel to tip,
+//! moved by the scene's `model.stroke` (at constant speed from its start time) or by a
+//! hand's tool pose (the tip at the tool's origin, the edge hanging below it, turned with
+//! the tool).
+
+use glam::{DQuat, DVec3};
+use incise_sim::nakao_cut::BladePose;
+
+use super::interface::ToolInput;
+use crate::scene::StrokeSpec;
+
+/// The edge of a hand-held blade when the scene gives none: 8 mm, heel below tip.
+const DEFAULT_EDGE: DVec3 = DVec3::new(0.0, 0.0, 0.008);
+
+/// A scene's blade: its scripted stroke, if any, and its edge (heel to tip).
+#[derive(Debug, Clone)]
+pub struct Blade {
+    stroke: Option<StrokeSpec>,
+    edge: DVec3,
+}
+
+impl Blade {
+    /// The blade of a scene with `stroke` (its edge: the stroke's heel to tip).
+    pub fn of_stroke(stroke: Option<StrokeSpec>) -> Blade {
+        let edge = stroke
+            .as_ref()
+            .map_or(DEFAULT_EDGE, |s| (s.tip - s.heel).as_dvec3());
+        Blade { stroke, edge }
+    }
+
+    /// Where `tool` puts the blade at simulated time `t`, whether it cuts, and where a cut
+    /// that starts now begins (`previous`: the blade's last pose); `None`: no blade.
+    pub fn at(
+        &self,
+        tool: &ToolInput,
+        t: f64,
+        previous: Option<BladePose>,
+    ) -> Option<(BladePose, bool, BladePose)> {
+        match tool {
+            ToolInput::Script => {
+                let s = self.stroke.as_ref()?;
+                let (pose, progress) = blade_at(s, t);
+                let begin = blade_at(s, s.start as f64).0;
+                Some((pose, progress > 0.0 && progress < 1.0, begin))
+            }
+            ToolInput::Hand { pose, engaged } => {
+                let tip = pose.position.as_dvec3();
+                let turn = DQuat::from_array(pose.rotation.to_array().map(f64::from));
+                let blade = BladePose {
+                    heel: tip - turn * self.edge,
+                    tip,
+                };
+                Some((blade, *engaged, previous.unwrap_or(blade)))
+            }
+        }
+    }
+}
+
+/// The blade pose at time `t` along stroke `s` and the stroke's progress (0 before it
+/// starts, 1 at its end).
+pub fn blade_at(s: &StrokeSpec, t: f64) -> (BladePose, f64) {
+    let length = s.travel.length() as f64;
+    let progress = if length > 0.0 {
+        ((t - s.start as f64) * s.speed as f64 / length).clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let d: DVec3 = s.travel.as_dvec3() * progress;
+    (
+        BladePose {
+            heel: s.heel.as_dvec3() + d,
+            tip: s.tip.as_dvec3() + d,
+        },
+        progress,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Quat, Vec3};
+    use incise_sim::contact::ToolPose;
+
+    fn stroke() -> StrokeSpec {
+        StrokeSpec {
+            heel: Vec3::new(0.0, 0.0, -0.002),
+            tip: Vec3::new(0.0, 0.0, 0.006),
+            travel: Vec3::new(0.1, 0.0, 0.0),
+            speed: 0.2,
+            start: 0.2,
+        }
+    }
+
+    #[test]
+    fn the_script_cuts_between_the_strokes_start_and_end() {
+        let b = Blade::of_stroke(Some(stroke()));
+        let (_, before, _) = b.at(&ToolInput::Script, 0.1, None).unwrap();
+        let (pose, during, begin) = b.at(&ToolInput::Script, 0.45, None).unwrap();
+        let (_, after, _) = b.at(&ToolInput::Script, 0.8, None).unwrap();
+        assert!(!before && during && !after);
+        assert!((pose.heel.x - 0.05).abs() < 1e-9 && begin.heel.x == 0.0);
+    }
+
+    #[test]
+    fn a_hand_turns_the_edge_with_the_tool() {
+        let b = Blade::of_stroke(Some(stroke()));
+        let pose = ToolPose {
+            position: Vec3::new(0.01, 0.0, 0.0),
+            rotation: Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        };
+        let hand = ToolInput::Hand {
+            pose,
+            engaged: true,
+        };
+        let (blade, engaged, begin) = b.at(&hand, 0.0, None).unwrap();
+        assert!(engaged && begin == blade);
+        // +z turned a quarter about y is +x: the 8 mm edge now lies along x, its tip at
+        // the tool's origin.
+        assert!((blade.tip - blade.heel - DVec3::new(0.008, 0.0, 0.0)).length() < 1e-6);
+        assert!((blade.tip - DVec3::new(0.01, 0.0, 0.0)).length() < 1e-6);
+    }
+}

@@ -1,0 +1,292 @@
+//! Issue 20: every method in every mode. Each method's scene opens in the preview window
+//! (under Xvfb) and on the simulated headset through the one `SimBody` interface, and
+//! each checks the method's own result there: XPBD releases tets, the Nakao cutter adds
+//! nodes and tets and the wound opens (also when the controller's scalpel cuts, with
+//! vibration from the method's own tool force), the rheological body is pressed to the
+//! indenter's depth and creeps back.
+//!
+//! The preview tests need `xvfb-run` and a wgpu adapter (lavapipe will do); without them
+//! they print why and pass, unless `INCISE_REQUIRE_GPU=1` (CI). The headset tests need a
+//! wgpu adapter likewise.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use common::{incise, temp_dir, text};
+
+fn required() -> bool {
+    std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
+}
+
+/// Whether `o` failed for want of a GPU adapter and the test may be skipped.
+fn no_adapter(o: &Output) -> bool {
+    let err = text(&o.stderr);
+    let missing = !o.status.success() && err.contains("no GPU adapter");
+    if missing {
+        assert!(!required(), "INCISE_REQUIRE_GPU=1 but: {err}");
+        eprintln!("skipping: {err}");
+    }
+    missing
+}
+
+/// `incise preview SCENE --frames N` in a window under Xvfb; its stdout, or `None` (the
+/// test skipped, saying why).
+fn preview(name: &str, scene: &str, frames: u32) -> Option<String> {
+    if Command::new("xvfb-run").arg("--help").output().is_err() {
+        assert!(!required(), "INCISE_REQUIRE_GPU=1 but xvfb-run is missing");
+        eprintln!("skipping: xvfb-run is not installed");
+        return None;
+    }
+    let dir = temp_dir(name);
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_incise"))
+        .args(["preview", scene, "--device", "cpu", "--size", "640x480"])
+        .args(["--frames", &frames.to_string(), "--screenshot"])
+        .arg(dir.join("window.png"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", &dir)
+        .output()
+        .expect("xvfb-run runs");
+    if no_adapter(&o) {
+        return None;
+    }
+    assert!(
+        o.status.success(),
+        "preview of {scene}: {}",
+        text(&o.stderr)
+    );
+    assert!(dir.join("window.png").exists(), "no screenshot of {scene}");
+    Some(text(&o.stdout))
+}
+
+/// `incise xr SCENE --simulated-headset SCRIPT --out OUT`; its stdout, or `None`.
+fn headset(scene: &str, script: &Path, out: &Path) -> Option<String> {
+    let o = incise(&[
+        "xr",
+        scene,
+        "--simulated-headset",
+        script.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    if no_adapter(&o) {
+        return None;
+    }
+    assert!(
+        o.status.success(),
+        "headset on {scene}: {}",
+        text(&o.stderr)
+    );
+    Some(text(&o.stdout))
+}
+
+/// A small simulated-headset script of `duration` s looking down at the tray, with an
+/// optional right-hand track (RON), written into `dir`.
+fn script(dir: &Path, duration: f64, right: &str) -> std::path::PathBuf {
+    let path = dir.join("headset.ron");
+    let text = format!(
+        "(display_hz: 72.0, eye_size: (160, 160), duration: {duration}, render_every: 24,
+          screenshots: [24], pacing: Nominal,
+          head: [(t: 0.0, position: (0.0, 1.25, -0.05),
+                  orientation: (-0.34202, 0.0, 0.0, 0.93969))],
+          {right})"
+    );
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The number after `before` in `line` (e.g. "cut added 72 nodes": "cut added ").
+fn number_after(line: &str, before: &str) -> f64 {
+    let at = line
+        .find(before)
+        .unwrap_or_else(|| panic!("no {before:?} in {line}"))
+        + before.len();
+    let digits: String = line[at..]
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '.')
+        .collect();
+    digits
+        .parse()
+        .unwrap_or_else(|_| panic!("no number after {before:?} in {line}"))
+}
+
+/// The report a headset session wrote.
+fn report(out: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn xpbd_preview_releases_tets_along_the_stroke() {
+    let Some(out) = preview("mm-xpbd", "config/plate_cut.ron", 60) else {
+        return;
+    };
+    let released = number_after(&out, "frames, ");
+    assert!(released > 50.0, "{out}");
+}
+
+#[test]
+fn nakao_preview_cuts_the_plate_and_the_wound_opens() {
+    let Some(out) = preview("mm-nakao", "config/plate_cut_nakao.ron", 80) else {
+        return;
+    };
+    assert!(out.contains("(mass-spring)"), "{out}");
+    let (nodes, tets) = (
+        number_after(&out, "cut added "),
+        number_after(&out, " nodes and "),
+    );
+    let width = number_after(&out, "wound open ");
+    assert!(nodes > 40.0 && tets > 80.0, "{out}");
+    assert!(width > 0.5 && width < 20.0, "opening {width} mm: {out}");
+}
+
+#[test]
+fn rheology_preview_presses_and_creeps_back() {
+    // organ_layers: 3.1 s at the default 1/60 s frame.
+    let Some(out) = preview("mm-rheology", "config/organ_layers.ron", 186) else {
+        return;
+    };
+    let (max, residual) = (
+        number_after(&out, "dent max "),
+        number_after(&out, "residual "),
+    );
+    assert!((max - 30.0).abs() < 1.0, "pressed {max} mm: {out}");
+    assert!(residual > 0.1 && residual < 0.8 * max, "{out}");
+}
+
+#[test]
+fn xpbd_headset_releases_tets() {
+    let out = temp_dir("mh-xpbd");
+    let Some(stdout) = headset(
+        "config/plate_cut.ron",
+        Path::new("config/xr/plate_cut_headset.ron"),
+        &out,
+    ) else {
+        return;
+    };
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("xr_report.json")).unwrap()).unwrap();
+    assert!(r["released_tets"].as_u64().unwrap() > 20, "{stdout}");
+}
+
+#[test]
+fn nakao_headset_cuts_by_its_stroke_and_by_the_controller_with_its_own_force() {
+    let dir = temp_dir("mh-nakao");
+    // The scene's blade stroke (0.2–0.9 s) while nobody holds the trigger.
+    let scripted = dir.join("scripted");
+    let Some(stdout) = headset(
+        "config/plate_cut_nakao.ron",
+        &script(&dir, 0.9, ""),
+        &scripted,
+    ) else {
+        return;
+    };
+    let r = report(&scripted);
+    assert_eq!(r["method"], "nakao", "{stdout}");
+    assert!(
+        r["nakao"]["nodes_added"].as_u64().unwrap() > 40,
+        "{}",
+        r["nakao"]
+    );
+    assert!(r["nakao"]["opening_width_m"].as_f64().unwrap() > 5e-4);
+    assert!(scripted.join("eye_left_00024.png").exists());
+    // The right controller draws a 10 cm incision 4 mm deep with the trigger held.
+    let hand = dir.join("hand");
+    let right = "right: Some(Tool(start: 0.1, stroke: Incision((start: (-0.05, 0.0, 0.002),
+        end: (0.05, 0.0, 0.002), depth: 0.004, speed: 0.1, approach: 0.005)))),
+        trigger: [(0.0, 1.0)],";
+    let stdout = headset(
+        "config/plate_cut_nakao.ron",
+        &script(&dir, 1.6, right),
+        &hand,
+    )
+    .unwrap();
+    let r = report(&hand);
+    assert!(
+        r["nakao"]["nodes_added"].as_u64().unwrap() > 10,
+        "{}",
+        r["nakao"]
+    );
+    // The tool point is coupled to the tissue by the haptic loop's virtual spring: the
+    // controller vibrates with that force.
+    let pulses = number_after(&stdout, "rendered), ");
+    assert!(pulses > 10.0, "{stdout}");
+}
+
+#[test]
+fn rheology_headset_presses_and_creeps_back() {
+    let dir = temp_dir("mh-rheology");
+    let out = dir.join("out");
+    let Some(stdout) = headset("config/organ_layers.ron", &script(&dir, 3.1, ""), &out) else {
+        return;
+    };
+    let r = report(&out);
+    assert_eq!(r["method"], "rheology", "{stdout}");
+    let dents: Vec<f64> = r["frames"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["dent_depth"].as_f64().unwrap())
+        .collect();
+    let max = dents.iter().copied().fold(0.0, f64::max);
+    let end = *dents.last().unwrap();
+    assert!((max - 0.03).abs() < 1e-3, "pressed {max} m");
+    assert!(
+        end > 1e-4 && end < 0.8 * max,
+        "crept back to {end} m from {max} m"
+    );
+}
+
+/// The scene files shipped in config/ (the `.ron` files that are scenes, not presets).
+fn shipped_scenes() -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut scenes: Vec<String> = std::fs::read_dir(root.join("config"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .filter(|p| incise::scene::load_scene(p).is_ok())
+        .map(|p| format!("config/{}", p.file_name().unwrap().to_string_lossy()))
+        .collect();
+    scenes.sort();
+    scenes
+}
+
+#[test]
+fn every_shipped_scene_opens_in_the_preview_and_on_the_headset() {
+    let scenes = shipped_scenes();
+    // All three methods are among them.
+    for s in [
+        "plate_cut.ron",
+        "plate_cut_nakao.ron",
+        "chest_incision_nakao.ron",
+        "organ_layers.ron",
+    ] {
+        assert!(
+            scenes.iter().any(|x| x.ends_with(s)),
+            "{s} not found in {scenes:?}"
+        );
+    }
+    let dir = temp_dir("mm-every");
+    // 4 display frames, every other one drawn.
+    let text = std::fs::read_to_string(script(&dir, 0.05, "")).unwrap();
+    let tiny_path = dir.join("tiny.ron");
+    std::fs::write(
+        &tiny_path,
+        text.replace("render_every: 24", "render_every: 2"),
+    )
+    .unwrap();
+    for scene in &scenes {
+        if let Some(out) = preview("mm-every-preview", scene, 3) {
+            assert!(out.contains(" frames"), "preview of {scene}: {out}");
+        }
+        let out = dir.join("xr");
+        if let Some(stdout) = headset(scene, &tiny_path, &out) {
+            assert!(
+                stdout.contains("display frames"),
+                "headset on {scene}: {stdout}"
+            );
+        }
+    }
+}
