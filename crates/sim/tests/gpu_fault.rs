@@ -44,8 +44,11 @@ fn a_lost_device_hands_the_last_good_state_to_the_cpu() {
         .zip(rescued.positions())
         .map(|(p, q)| (*p - *q).length())
         .fold(0.0, f32::max);
+    // GPU and CPU round differently (the CPU's AVX lanes, its `ln`); in a bar that tears,
+    // 25 frames amplify that to ~1e-5 m (12 µm measured with the AVX lanes). 50 µm is
+    // 0.1 % of the 5 cm pull, the bound of the CPU kernels' own comparison.
     assert!(
-        worst < 1e-5,
+        worst < 5e-5,
         "the rescued run drifted {worst} m from the CPU run"
     );
     assert_eq!(cpu.cut().live(), rescued.cut().live());
