@@ -3,7 +3,7 @@
 //! body with a material per region (PHYSICS.md §3).
 
 use glam::{DVec2, Vec3};
-use incise_sim::mass_spring::{StiffnessLaw, Tension};
+use incise_sim::mass_spring::{HapticContact, StiffnessLaw, Tension};
 use incise_sim::nakao_cut::CutParams;
 use incise_sim::selection::NodeSelection;
 use serde::Deserialize;
@@ -178,6 +178,11 @@ pub struct MassSpringScene {
     /// or `Budget(ms)`, the refresh-rate manager (PHYSICS.md §2.5).
     #[serde(default)]
     pub localisation: Localisation,
+    /// How a hand-held tool is coupled to the tissue: `NearestNode` (default: a spring to
+    /// the node nearest the blade, which also holds the blade in the cut) or `GodObject`
+    /// (a proxy riding the surface, Zilles & Salisbury 1995: pushes back, never pulls).
+    #[serde(default)]
+    pub haptic_contact: HapticContact,
 }
 
 fn default_stiffness() -> f64 {

@@ -14,7 +14,7 @@ use glam::{DVec3, Quat, Vec3};
 use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::mass_spring::{
-    HapticConfig, LocalLoop, LocalLoopParams, MassSpringModel, SystemClock,
+    HapticConfig, LocalLoop, LocalLoopParams, MassSpringModel, SystemClock, ToolCoupling,
 };
 use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, opening_width};
 use incise_sim::nakao_cut::{BladePose, Cutter};
@@ -51,6 +51,8 @@ pub struct NakaoBody {
     total_volume: f64,
     /// Force of the tissue on a hand's tool in the last frame (`None`: scripted blade).
     force: Option<DVec3>,
+    /// How a hand's tool is coupled to the tissue (the scene's `haptic_contact`).
+    coupling: ToolCoupling,
 }
 
 impl NakaoBody {
@@ -75,6 +77,10 @@ impl NakaoBody {
             frame: 0,
             total_volume,
             force: None,
+            coupling: ToolCoupling::of(&HapticConfig {
+                contact: ms.haptic_contact,
+                ..HapticConfig::default()
+            }),
         }
     }
 
@@ -158,24 +164,18 @@ impl NakaoBody {
         }
     }
 
-    /// A hand's tool point (the middle of the blade edge) coupled to the nearest node
-    /// within the contact radius by the haptic loop's virtual spring (PHYSICS.md §2.6),
-    /// for the frame; the force of the tissue on the tool.
+    /// A hand's tool point (the middle of the blade edge) coupled to the tissue for the
+    /// frame as the scene's `haptic_contact` says, by the haptic loop's virtual spring
+    /// (PHYSICS.md §2.6); the force of the tissue on the tool.
     fn couple(&mut self) -> DVec3 {
         let Some(p) = self.pose else {
             return DVec3::ZERO;
         };
         let tip = (p.heel + p.tip) * 0.5;
-        let config = HapticConfig::default();
-        let near = self.model.nearest_node(tip).filter(|&n| {
-            (self.model.positions()[n as usize] - tip).length() <= config.contact_radius
-        });
-        let Some(n) = near else {
-            return DVec3::ZERO;
-        };
-        let f = config.coupling * (tip - self.model.positions()[n as usize]);
-        self.model.set_external_force(n, f);
-        -f
+        let nodes = self
+            .coupling
+            .nodes(&self.model, tip, |m, q| m.nearest_node(q));
+        self.coupling.pull(&mut self.model, &nodes, tip)
     }
 
     /// Go back to the last completed frame, the blade lifted.

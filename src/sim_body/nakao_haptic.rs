@@ -64,6 +64,7 @@ impl NakaoHapticBody {
                 publish_hz: 1.0 / frame_dt,
                 local: haptic_localisation(ms.localisation),
                 cut: ms.cut.clone(),
+                contact: ms.haptic_contact,
                 ..HapticConfig::default()
             },
             blade: Blade::of_stroke(Some(stroke)),

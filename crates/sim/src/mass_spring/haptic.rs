@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 
-use super::god_object::{GodObject, ProxySurface};
+use super::tool_coupling::ToolCoupling;
 use super::{LocalLoop, LocalLoopParams, MassSpringModel, SystemClock};
 use crate::nakao_cut::{BladePose, CutParams, Cutter};
 
@@ -102,10 +102,11 @@ struct Shared {
     stop: AtomicBool,
 }
 
-/// The running haptic thread; [`HapticLoop::stop`] returns the model.
+/// The running haptic thread; [`HapticLoop::stop`] returns the model (dropping the loop
+/// stops the thread too).
 pub struct HapticLoop {
     shared: Arc<Shared>,
-    handle: JoinHandle<MassSpringModel>,
+    handle: Option<JoinHandle<MassSpringModel>>,
 }
 
 impl HapticLoop {
@@ -118,7 +119,7 @@ impl HapticLoop {
             stop: AtomicBool::new(false),
         });
         let s = Arc::clone(&shared);
-        let handle = std::thread::spawn(move || run(model, config, &s));
+        let handle = Some(std::thread::spawn(move || run(model, config, &s)));
         HapticLoop { shared, handle }
     }
 
@@ -148,9 +149,23 @@ impl HapticLoop {
     }
 
     /// Stop the thread and return the model.
-    pub fn stop(self) -> std::thread::Result<MassSpringModel> {
+    pub fn stop(mut self) -> std::thread::Result<MassSpringModel> {
         self.shared.stop.store(true, Ordering::Release);
-        self.handle.join()
+        match self.handle.take() {
+            Some(h) => h.join(),
+            None => Err(Box::new("the haptic thread was already joined")),
+        }
+    }
+}
+
+impl Drop for HapticLoop {
+    /// A loop dropped without [`HapticLoop::stop`] (its body dropped mid-run) stops its
+    /// thread rather than leave it spinning at the haptic rate.
+    fn drop(&mut self) {
+        self.shared.stop.store(true, Ordering::Release);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
     }
 }
 
@@ -162,7 +177,7 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
     let mut local = LocalLoop::new(config.local.clone(), SystemClock::default());
     let mut cutter = Cutter::new(config.cut.clone());
     let mut blade_seen: Option<BladePose> = None;
-    let mut couple = Coupling::new(&config);
+    let mut couple = ToolCoupling::of(&config);
     let mut next = Instant::now() + period;
     let (mut loops, mut overruns, mut snapshots, mut cuts) = (0u64, 0u64, 0u64, 0u64);
     while !shared.stop.load(Ordering::Acquire) {
@@ -183,7 +198,7 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
         let substeps = (h / model.stable_dt()).ceil().max(1.0) as u32;
         let dt = h / substeps as f64;
         let (force, free) = match tip {
-            Some(tip) => couple.step(&mut model, &mut local, tip, substeps, dt),
+            Some(tip) => couple.haptic_loop(&mut model, &mut local, tip, substeps, dt),
             None => {
                 for _ in 0..substeps {
                     model.step(dt);
@@ -234,87 +249,6 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
     model
 }
 
-/// The tool's coupling in the loop: the settings and, for a god object, its proxy and the
-/// surface it rides (rebuilt when a cut changes the tets).
-struct Coupling {
-    contact: HapticContact,
-    stiffness: f64,
-    radius: f64,
-    god: GodObject,
-    surface: ProxySurface,
-}
-
-impl Coupling {
-    fn new(config: &HapticConfig) -> Self {
-        Coupling {
-            contact: config.contact,
-            stiffness: config.coupling,
-            radius: config.contact_radius,
-            god: GodObject::default(),
-            surface: ProxySurface::default(),
-        }
-    }
-
-    /// One loop's `substeps` with the tool at `tip`: the force on the tool, N, and the free
-    /// nodes of the last localised step.
-    fn step(
-        &mut self,
-        model: &mut MassSpringModel,
-        local: &mut LocalLoop<SystemClock>,
-        tip: DVec3,
-        substeps: u32,
-        dt: f64,
-    ) -> (DVec3, usize) {
-        let nodes = self.nodes(model, local, tip);
-        let mut force = DVec3::ZERO;
-        let mut free = 0;
-        for _ in 0..substeps {
-            if !nodes.is_empty() {
-                let x = model.positions();
-                let at: DVec3 = nodes.iter().map(|&(n, w)| x[n as usize] * w).sum();
-                force = self.stiffness * (at - tip);
-                for &(n, w) in &nodes {
-                    model.set_external_force(n, -force * w);
-                }
-            }
-            free = local.step(model, tip, dt).free_nodes;
-        }
-        model.clear_external_forces();
-        (force, free)
-    }
-
-    /// The nodes the tool pulls on this loop, with their weights (summing to 1); none when
-    /// the tool does not touch the tissue.
-    fn nodes(
-        &mut self,
-        model: &MassSpringModel,
-        local: &LocalLoop<SystemClock>,
-        tip: DVec3,
-    ) -> Vec<(u32, f64)> {
-        match self.contact {
-            HapticContact::NearestNode => local
-                .hierarchy()
-                .nearest_node(model, tip)
-                .filter(|&n| (model.positions()[n as usize] - tip).length() <= self.radius)
-                .map(|n| vec![(n, 1.0)])
-                .unwrap_or_default(),
-            HapticContact::GodObject => {
-                if self.surface.tet_count() != model.tet_count() {
-                    self.surface = ProxySurface::build(model.tets(), model.positions());
-                    self.god.rebind(&self.surface, model.positions());
-                }
-                self.god
-                    .update(tip, &self.surface, model.positions())
-                    .map(|c| {
-                        let t = self.surface.triangles()[c.triangle];
-                        (0..3).map(|k| (t[k], c.weights[k])).collect()
-                    })
-                    .unwrap_or_default()
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use glam::{UVec3, Vec3};
@@ -350,21 +284,21 @@ mod tests {
         m
     }
 
-    /// The tool's path in 1 kHz loops, run through [`Coupling::step`] without a thread:
+    /// The tool's path in 1 kHz loops, run through [`ToolCoupling::haptic_loop`] without a thread:
     /// the force on the tool each loop.
     fn drive(m: &mut MassSpringModel, contact: HapticContact, path: &[DVec3]) -> Vec<DVec3> {
         let config = HapticConfig {
             contact,
             ..HapticConfig::default()
         };
-        let mut couple = Coupling::new(&config);
+        let mut couple = ToolCoupling::of(&config);
         let mut local = LocalLoop::new(config.local.clone(), SystemClock::default());
         let h = 1.0 / config.rate_hz;
         let substeps = (h / m.stable_dt()).ceil().max(1.0) as u32;
         path.iter()
             .map(|&tip| {
                 couple
-                    .step(m, &mut local, tip, substeps, h / substeps as f64)
+                    .haptic_loop(m, &mut local, tip, substeps, h / substeps as f64)
                     .0
             })
             .collect()

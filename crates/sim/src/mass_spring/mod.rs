@@ -17,6 +17,7 @@ mod refresh;
 mod stiffness;
 mod tension;
 mod tet_tensor;
+mod tool_coupling;
 
 pub use adjacency::{ElementIndex, Rows};
 pub use axes::AxisMask;
@@ -30,6 +31,7 @@ pub use refresh::RefreshRateManager;
 pub use stiffness::StiffnessLaw;
 pub use tension::Tension;
 pub use tet_tensor::TetTensor;
+pub use tool_coupling::ToolCoupling;
 
 pub(crate) use tet_tensor::edge_frames;
 
