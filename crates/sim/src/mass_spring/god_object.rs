@@ -78,6 +78,11 @@ impl ProxySurface {
         &self.triangles
     }
 
+    /// The corners of triangle `t` at node positions `x`.
+    fn corners(&self, t: usize, x: &[DVec3]) -> [DVec3; 3] {
+        self.triangles[t].map(|v| x[v as usize])
+    }
+
     /// Triangles sharing a node with triangle `t` (itself included).
     fn around(&self, t: usize) -> impl Iterator<Item = usize> + '_ {
         self.triangles[t].into_iter().flat_map(|v| {
@@ -146,6 +151,30 @@ fn entry(p: DVec3, q: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
     ((0.0..=1.0).contains(&u) && v >= 0.0 && u + v <= 1.0 && (0.0..=1.0).contains(&t)).then_some(t)
 }
 
+/// Of the `triangles` of `surface` (node positions `x`), the one whose closest point to
+/// `p` is nearest, and that point; `None` when there are none.
+fn nearest_among(
+    p: DVec3,
+    triangles: impl IntoIterator<Item = usize>,
+    surface: &ProxySurface,
+    x: &[DVec3],
+) -> Option<(usize, DVec3)> {
+    triangles
+        .into_iter()
+        .map(|t| {
+            let [a, b, c] = surface.corners(t, x).map(|v| v.as_vec3());
+            (
+                t,
+                closest_point_on_triangle(p.as_vec3(), a, b, c).as_dvec3(),
+            )
+        })
+        .min_by(|a, b| {
+            (a.1 - p)
+                .length_squared()
+                .total_cmp(&(b.1 - p).length_squared())
+        })
+}
+
 impl GodObject {
     /// The proxy's contact, if the device is in the tissue.
     pub fn contact(&self) -> Option<ProxyContact> {
@@ -180,24 +209,8 @@ impl GodObject {
 
     /// The surface point nearest `p`, over every triangle.
     fn nearest(p: DVec3, surface: &ProxySurface, x: &[DVec3]) -> Option<ProxyContact> {
-        let corners = |t: &[u32; 3]| t.map(|v| x[v as usize]);
-        let (triangle, q) = surface
-            .triangles
-            .iter()
-            .enumerate()
-            .map(|(k, t)| {
-                let [a, b, c] = corners(t).map(|v| v.as_vec3());
-                (
-                    k,
-                    closest_point_on_triangle(p.as_vec3(), a, b, c).as_dvec3(),
-                )
-            })
-            .min_by(|a, b| {
-                (a.1 - p)
-                    .length_squared()
-                    .total_cmp(&(b.1 - p).length_squared())
-            })?;
-        let [a, b, c] = corners(&surface.triangles[triangle]);
+        let (triangle, q) = nearest_among(p, 0..surface.triangles.len(), surface, x)?;
+        let [a, b, c] = surface.corners(triangle, x);
         Some(ProxyContact {
             triangle,
             weights: barycentric(q, a, b, c),
@@ -207,19 +220,15 @@ impl GodObject {
     /// The first surface crossing of the device's path `p → q`.
     fn enter(p: DVec3, q: DVec3, surface: &ProxySurface, x: &[DVec3]) -> Option<ProxyContact> {
         let (lo, hi) = (p.min(q), p.max(q));
-        let corners = |t: &[u32; 3]| t.map(|v| x[v as usize]);
-        let (triangle, t) = surface
-            .triangles
-            .iter()
-            .enumerate()
-            .filter(|(_, t)| {
-                let c = corners(t);
+        let (triangle, t) = (0..surface.triangles.len())
+            .filter(|&k| {
+                let c = surface.corners(k, x);
                 let (tlo, thi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
                 tlo.cmple(hi).all() && thi.cmpge(lo).all()
             })
-            .filter_map(|(k, t)| entry(p, q, corners(t)).map(|f| (k, f)))
+            .filter_map(|k| entry(p, q, surface.corners(k, x)).map(|f| (k, f)))
             .min_by(|a, b| a.1.total_cmp(&b.1))?;
-        let [a, b, c] = corners(&surface.triangles[triangle]);
+        let [a, b, c] = surface.corners(triangle, x);
         let weights = barycentric(p + (q - p) * t, a, b, c);
         Some(ProxyContact { triangle, weights })
     }
@@ -232,22 +241,10 @@ impl GodObject {
         surface: &ProxySurface,
         x: &[DVec3],
     ) -> Option<ProxyContact> {
-        let corners = |t: usize| surface.triangles[t].map(|v| x[v as usize]);
-        let nearest = |t: usize| {
-            let [a, b, c] = corners(t).map(|p| p.as_vec3());
-            closest_point_on_triangle(device.as_vec3(), a, b, c).as_dvec3()
-        };
         let mut here = c.triangle;
-        let mut point = nearest(here);
+        let mut point = nearest_among(device, [here], surface, x)?.1;
         for _ in 0..16 {
-            let best = surface
-                .around(here)
-                .map(|t| (t, nearest(t)))
-                .min_by(|a, b| {
-                    (a.1 - device)
-                        .length_squared()
-                        .total_cmp(&(b.1 - device).length_squared())
-                })?;
+            let best = nearest_among(device, surface.around(here), surface, x)?;
             if best.0 == here
                 || (best.1 - device).length_squared() >= (point - device).length_squared()
             {
@@ -255,7 +252,7 @@ impl GodObject {
             }
             (here, point) = best;
         }
-        let [a, b, cc] = corners(here);
+        let [a, b, cc] = surface.corners(here, x);
         let normal = (b - a).cross(cc - a);
         if (device - point).dot(normal) > 0.0 {
             return None;
