@@ -142,6 +142,30 @@ fn nakao_preview_cuts_the_plate_and_the_wound_opens() {
     assert!(width > 0.5 && width < 20.0, "opening {width} mm: {out}");
 }
 
+/// Issue 21: the preview's panel shows the level the refresh-rate manager picks each
+/// frame on the chest scene (budget 5.6 ms) and the loop's split; on closing, the preview
+/// prints the last frame's lines as the panel showed them.
+#[test]
+fn nakao_preview_shows_the_level_the_manager_picks() {
+    let Some(out) = preview("mm-nakao-level", "config/chest_incision_nakao.ron", 12) else {
+        return;
+    };
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("last frame's localisation: level "))
+        .unwrap_or_else(|| panic!("no localisation line: {out}"));
+    assert!(line.contains("(manager, budget 5.6 ms)"), "{line}");
+    let level = number_after(line, "level ");
+    let free = number_after(line, "ms), ");
+    assert!((1.0..=30.0).contains(&level), "{line}");
+    assert!(free > 10.0 && free < 73_000.0, "{line}");
+    let split = out
+        .lines()
+        .find(|l| l.starts_with("last frame's loop ms: "))
+        .unwrap_or_else(|| panic!("no loop split: {out}"));
+    assert!(number_after(split, "force ") > 0.0, "{split}");
+}
+
 #[test]
 fn rheology_preview_presses_and_creeps_back() {
     // organ_layers: 3.1 s at the default 1/60 s frame.

@@ -13,8 +13,9 @@ use incise_sim::skin::Skin;
 use incise_sim::{RawMesh, TetMesh};
 use incise_xr::BodyState;
 
-use crate::report::{FrameRecord, Report};
-use crate::scene::load_scene;
+use crate::report::localisation::live_lines;
+use crate::report::{FrameData, FrameRecord, Report};
+use crate::scene::{ModelChoice, load_scene};
 use crate::sim_body::{DeviceChoice, OpenOptions, Quantity, SimBody, TetView, ToolInput, open};
 
 /// What the renderer draws of the body's current topology.
@@ -40,6 +41,8 @@ pub struct DrawnBody {
     per_tet: Vec<f32>,
     /// Top of the heat-map scale: the largest value seen so far.
     pub scale: f32,
+    /// A mass-spring scene's localisation setting ("whole", "level d", "budget B ms").
+    localisation: Option<String>,
 }
 
 impl DrawnBody {
@@ -51,6 +54,10 @@ impl DrawnBody {
             ..OpenOptions::default()
         };
         let (body, report) = open(&scene, path, &opts)?;
+        let localisation = match &scene.model {
+            ModelChoice::MassSpring(ms) => Some(ms.localisation.label()),
+            _ => None,
+        };
         let view = body.tet_view();
         let render = render_mesh(&view).with_context(|| format!("{}: drawing", path.display()))?;
         let mut m = DrawnBody {
@@ -60,6 +67,7 @@ impl DrawnBody {
             render,
             per_tet: Vec::new(),
             scale: 0.0,
+            localisation,
         };
         m.colour();
         Ok(m)
@@ -73,6 +81,19 @@ impl DrawnBody {
     /// Frames stepped so far.
     pub fn frames(&self) -> usize {
         self.report.frames.len()
+    }
+
+    /// The last frame's localisation as the live view shows it: the level chosen (by the
+    /// refresh-rate manager under a budget) and the loop's time split; empty for other
+    /// methods and before the first frame.
+    pub fn live_lines(&self) -> Vec<String> {
+        match (
+            &self.localisation,
+            self.report.frames.last().map(|f| &f.stats),
+        ) {
+            (Some(setting), Some(FrameData::Edges(s))) => live_lines(setting, s),
+            _ => Vec::new(),
+        }
     }
 
     /// The heat-map value of each render tet, and the scale's top.

@@ -3,8 +3,11 @@
 //! the scene's own script (the Nakao blade's stroke, the rheology indenter) until the
 //! left button takes the tool: then the mouse scalpel cuts (Nakao) or presses (rheology)
 //! where it is. Right-drag orbits, middle- or shift+right-drag pans, the wheel zooms,
-//! Space plays/pauses, Escape quits. `--frames N` steps and draws N frames and closes,
-//! printing the body's report summary (what it cut, how deep it was pressed).
+//! Space plays/pauses, Escape quits. The panel shows a Nakao body's localisation each
+//! frame: the level chosen (by the refresh-rate manager under a budget), the free nodes
+//! and the loop's time split. `--frames N` steps and draws N frames and closes, printing
+//! the body's report summary (what it cut, how deep it was pressed) and the last frame's
+//! localisation lines as the panel showed them.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -49,7 +52,11 @@ pub fn run(w: MethodWindow) -> Result<()> {
         .run_app(&mut app)
         .map_err(|e| anyhow!("window event loop: {e}"))?;
     if let Some(live) = app.live.take() {
+        let lines = live.body.live_lines();
         println!("{}", live.body.close(None)?);
+        for line in lines {
+            println!("last frame's {line}");
+        }
     }
     app.result
 }
@@ -298,6 +305,7 @@ impl Live {
         let input = self.egui_winit.take_egui_input(&self.window);
         let body = &self.body;
         let (method, quantity) = (body.body.method().name(), body.quantity());
+        let live_lines = body.live_lines();
         let (mut width, mut playing) = (0.0, self.playing);
         let message = &self.message;
         let out = self.egui.run_ui(input, |ui| {
@@ -315,6 +323,9 @@ impl Live {
                             "heat map: {} (0 – {:.3e} {})",
                             q.name, body.scale, q.unit
                         ));
+                    }
+                    for line in &live_lines {
+                        ui.label(line.as_str());
                     }
                     ui.checkbox(&mut playing, "play (Space)");
                     ui.small("Left-drag: cut or press · right-drag: orbit · wheel: zoom");

@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use super::EdgeFrameStats;
+
 /// Time split of one frame's loop, ms.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct LoopSplit {
@@ -110,6 +112,34 @@ impl LocalisationInfo {
     }
 }
 
+/// What a live view (the preview's panel, its closing lines) shows of one mass-spring
+/// frame's localisation under the scene's `setting` ("whole", "level d", "budget B ms"):
+/// the level chosen and the nodes it freed, then the loop's time split. Empty for a frame
+/// with no localisation figures (another method's, or a haptic-thread frame).
+pub fn live_lines(setting: &str, s: &EdgeFrameStats) -> Vec<String> {
+    let Some(free) = s.free_nodes else {
+        return Vec::new();
+    };
+    let chosen = match s.level {
+        Some(l) if setting.starts_with("budget") => {
+            format!("level {l} (manager, {setting}), {free} nodes free")
+        }
+        Some(l) => format!("level {l} ({setting}), {free} nodes free"),
+        None => format!("whole mesh, {free} nodes"),
+    };
+    let ms = |v: Option<f64>| v.unwrap_or(0.0);
+    vec![
+        format!("localisation: {chosen}"),
+        format!(
+            "loop ms: localise {:.2} · force {:.2} · integrate {:.2} · cut {:.2}",
+            ms(s.localise_ms),
+            ms(s.force_ms),
+            ms(s.integrate_ms),
+            ms(s.cut_ms)
+        ),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,5 +166,32 @@ mod tests {
         assert_eq!(info.free_nodes.max, 232.0);
         assert!((info.total_ms.mean - 2.1).abs() < 1e-12);
         assert!(LocalisationInfo::of("whole".into(), None, &[]).is_none());
+    }
+
+    #[test]
+    fn live_lines_name_the_level_the_manager_chose_and_the_split() {
+        let s = EdgeFrameStats {
+            level: Some(3),
+            free_nodes: Some(512),
+            localise_ms: Some(0.25),
+            force_ms: Some(4.5),
+            integrate_ms: Some(1.0),
+            cut_ms: Some(0.125),
+            ..EdgeFrameStats::default()
+        };
+        let lines = live_lines("budget 5.6 ms", &s);
+        assert_eq!(
+            lines[0],
+            "localisation: level 3 (manager, budget 5.6 ms), 512 nodes free"
+        );
+        assert_eq!(
+            lines[1],
+            "loop ms: localise 0.25 · force 4.50 · integrate 1.00 · cut 0.12"
+        );
+        assert_eq!(
+            live_lines("level 4", &s)[0],
+            "localisation: level 3 (level 4), 512 nodes free"
+        );
+        assert!(live_lines("whole", &EdgeFrameStats::default()).is_empty());
     }
 }
