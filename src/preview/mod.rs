@@ -14,28 +14,26 @@ mod panel;
 pub mod pick;
 pub mod scalpel_input;
 mod session;
+mod window_app;
 mod window_gpu;
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow, bail};
-use incise_xr::{BodyState, Camera, RenderSettings, Renderer, View};
-use winit::application::ApplicationHandler;
-use winit::event::{ElementState, MouseButton, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, EventLoop};
-use winit::window::{Fullscreen, Window, WindowId};
+use incise_xr::{BodyState, RenderSettings, Renderer};
+use winit::event::{ElementState, MouseScrollDelta};
+use winit::keyboard::ModifiersState;
 
 use crate::pictures::screenshots::{ImageSize, Screenshots, stress_scale};
 use crate::sim_body::{Body, DeviceChoice};
 
 use crate::exercise::LiveExercise;
-use camera_input::{CameraInput, KeyAction, preview_camera, wheel_steps};
+use camera_input::{KeyAction, preview_camera, wheel_steps};
 use frame_times::{FrameTime, FrameTimes};
 use panel::{Action, ExerciseInfo, Panel, PanelInfo, ScalpelInfo};
 use session::{Session, scene_files};
-use window_gpu::{PanelFrame, WindowGpu};
+use window_app::{WindowContent, WindowShell, run_window, save_frame};
 
 /// Options of `incise preview`.
 #[derive(Debug, Clone)]
@@ -76,25 +74,17 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
             size: opts.size,
         });
     }
-    let event_loop = EventLoop::new().map_err(|e| anyhow!("cannot open a window: {e}"))?;
-    let mut app = App {
-        opts,
-        live: None,
-        result: Ok(()),
+    let Some(live) = run_window(opts.size, |shell| Live::open(shell, opts))? else {
+        return Ok(());
     };
-    event_loop
-        .run_app(&mut app)
-        .map_err(|e| anyhow!("window event loop: {e}"))?;
-    if let Some(live) = app.live.as_ref().filter(|_| app.result.is_ok()) {
-        let solver = live.session.body.solver();
-        println!(
-            "preview of {}: {} frames, {} tets released",
-            live.session.name(),
-            solver.frame(),
-            solver.cut().released_count()
-        );
-    }
-    app.result
+    let solver = live.session.body.solver();
+    println!(
+        "preview of {}: {} frames, {} tets released",
+        live.session.name(),
+        solver.frame(),
+        solver.cut().released_count()
+    );
+    Ok(())
 }
 
 /// Whether the scene at `path` runs the XPBD method (the full preview with its panel of
@@ -105,143 +95,65 @@ fn is_xpbd(path: &Path) -> Result<bool> {
     Ok(matches!(scene.model, crate::scene::ModelChoice::Xpbd))
 }
 
-struct App {
-    opts: PreviewOptions,
-    live: Option<Live>,
-    result: Result<()>,
-}
-
 /// Everything that exists while the window is open.
 struct Live {
-    window: Arc<Window>,
-    gpu: WindowGpu,
+    shell: WindowShell,
+    opts: PreviewOptions,
     session: Session,
     renderer: Renderer,
-    egui: egui::Context,
-    egui_winit: egui_winit::State,
-    camera: Camera,
-    home: Camera,
-    input: CameraInput,
     panel: Panel,
     times: FrameTimes,
     last_frame: Instant,
     frames_drawn: u64,
     capture_next: bool,
-    /// The last drawn view and its size in pixels (for cursor rays).
-    view: Option<(View, (u32, u32))>,
-    /// Cursor position, physical pixels.
-    cursor: Option<(f64, f64)>,
     /// Whether the left button holds the blade in the tissue.
     left_down: bool,
     /// Ctrl is held (the wheel sets the depth).
     ctrl: bool,
-    /// Escape was pressed: the next frame is the last.
-    quitting: bool,
     /// The open exercise.
     exercise: Option<LiveExercise>,
 }
 
-impl ApplicationHandler for App {
-    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.live.is_some() {
-            return;
-        }
-        match Live::open(event_loop, &self.opts) {
-            Ok(l) => self.live = Some(l),
-            Err(e) => {
-                self.result = Err(e);
-                event_loop.exit();
-            }
+impl WindowContent for Live {
+    fn shell(&mut self) -> &mut WindowShell {
+        &mut self.shell
+    }
+
+    fn frame(&mut self) -> Result<bool> {
+        self.step_and_draw()
+    }
+
+    fn left_button(&mut self, state: ElementState) {
+        self.scalpel_button(state);
+    }
+
+    fn cursor_moved(&mut self) {
+        self.scalpel_cursor();
+    }
+
+    fn key(&mut self, action: KeyAction) {
+        if action == KeyAction::PlayPause {
+            self.panel.playing = !self.panel.playing;
         }
     }
 
-    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
-        let Some(live) = &mut self.live else { return };
-        let consumed = live
-            .egui_winit
-            .on_window_event(&live.window, &event)
-            .consumed;
-        match event {
-            WindowEvent::CloseRequested => event_loop.exit(),
-            WindowEvent::Resized(s) => live.gpu.resize(s.width, s.height),
-            WindowEvent::RedrawRequested => match live.frame(&self.opts) {
-                Ok(true) => {}
-                Ok(false) => event_loop.exit(),
-                Err(e) => {
-                    self.result = Err(e);
-                    event_loop.exit();
-                }
-            },
-            WindowEvent::ModifiersChanged(m) => {
-                live.input.set_shift(m.state().shift_key());
-                live.ctrl = m.state().control_key();
-            }
-            WindowEvent::MouseInput { state, button, .. }
-                if !consumed || state == ElementState::Released =>
-            {
-                if button == MouseButton::Left {
-                    live.scalpel_button(state);
-                } else {
-                    live.input.button(button, state);
-                }
-            }
-            WindowEvent::CursorMoved { position, .. } => {
-                let h = live.window.inner_size().height as f64;
-                live.input
-                    .cursor(&mut live.camera, position.x, position.y, h);
-                live.cursor = Some((position.x, position.y));
-                live.scalpel_cursor();
-            }
-            WindowEvent::MouseWheel { delta, .. } if !consumed => {
-                if live.left_down || live.ctrl {
-                    live.session.hand.input.wheel(wheel_steps(delta));
-                } else {
-                    live.input.wheel(&mut live.camera, delta);
-                }
-            }
-            WindowEvent::KeyboardInput { event, .. }
-                if !consumed && event.state == ElementState::Pressed =>
-            {
-                match live
-                    .input
-                    .key(&mut live.camera, &live.home, &event.logical_key)
-                {
-                    KeyAction::None => {}
-                    KeyAction::PlayPause => live.panel.playing = !live.panel.playing,
-                    // Finish with one more frame (saving `--screenshot`), then close.
-                    KeyAction::Quit => live.quitting = true,
-                    KeyAction::Fullscreen => {
-                        let full = live
-                            .window
-                            .fullscreen()
-                            .is_none()
-                            .then_some(Fullscreen::Borderless(None));
-                        live.window.set_fullscreen(full);
-                    }
-                }
-            }
-            _ => {}
+    /// With the left button down or Ctrl held the wheel sets the cut depth; else it zooms.
+    fn wheel(&mut self, delta: MouseScrollDelta) {
+        if self.left_down || self.ctrl {
+            self.session.hand.input.wheel(wheel_steps(delta));
+        } else {
+            self.shell.input.wheel(&mut self.shell.camera, delta);
         }
     }
 
-    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
-        if let Some(live) = &self.live {
-            live.window.request_redraw();
-        }
+    fn modifiers(&mut self, m: ModifiersState) {
+        self.ctrl = m.control_key();
     }
 }
 
 impl Live {
-    fn open(event_loop: &ActiveEventLoop, opts: &PreviewOptions) -> Result<Live> {
-        let attrs = Window::default_attributes()
-            .with_title("incise preview")
-            .with_inner_size(winit::dpi::PhysicalSize::new(opts.size.0, opts.size.1));
-        let window = Arc::new(
-            event_loop
-                .create_window(attrs)
-                .map_err(|e| anyhow!("cannot open a window: {e}"))?,
-        );
-        let gpu = WindowGpu::new(window.clone())?;
+    fn open(mut shell: WindowShell, opts: PreviewOptions) -> Result<Live> {
+        let gpu = &shell.gpu;
         let device = match opts.device {
             // A software adapter runs the CPU solver faster than its own compute.
             DeviceChoice::Auto => {
@@ -274,16 +186,7 @@ impl Live {
             &session.skin,
         );
         renderer.set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&session.hand.tool));
-        let egui = egui::Context::default();
-        let egui_winit = egui_winit::State::new(
-            egui.clone(),
-            egui::ViewportId::ROOT,
-            &window,
-            Some(window.scale_factor() as f32),
-            None,
-            Some(gpu.dev.limits.max_texture_dimension_2d as usize),
-        );
-        let home = preview_camera(session.body.solver().mesh());
+        shell.set_home(preview_camera(session.body.solver().mesh()));
         let scene_dir = scene
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
@@ -302,34 +205,17 @@ impl Live {
                 show_result: false,
             },
             exercise,
-            window,
-            gpu,
+            shell,
+            opts,
             session,
             renderer,
-            egui,
-            egui_winit,
-            camera: home,
-            home,
-            input: CameraInput::default(),
             times: FrameTimes::default(),
             last_frame: Instant::now(),
             frames_drawn: 0,
             capture_next: false,
-            view: None,
-            cursor: None,
             left_down: false,
             ctrl: false,
-            quitting: false,
         })
-    }
-
-    /// The world ray through the cursor, if a frame has been drawn.
-    fn cursor_ray(&self) -> Option<(glam::Vec3, glam::Vec3)> {
-        let ((view, (w, h)), (x, y)) = (self.view.as_ref()?, self.cursor?);
-        Some(view.ray(
-            glam::Vec2::new(x as f32, y as f32),
-            glam::Vec2::new(*w as f32, *h as f32),
-        ))
     }
 
     /// The left button: down on the tissue starts a cut there (the mouse takes the blade
@@ -340,7 +226,7 @@ impl Live {
             self.left_down = false;
             return;
         }
-        let Some((o, d)) = self.cursor_ray() else {
+        let Some((o, d)) = self.shell.cursor_ray() else {
             return;
         };
         let solver = self.session.body.solver();
@@ -358,16 +244,17 @@ impl Live {
     /// The cursor moved: the blade follows on its plane (not while the camera is dragged,
     /// nor over the panel unless cutting).
     fn scalpel_cursor(&mut self) {
-        if self.input.dragging() || (!self.left_down && self.egui.is_pointer_over_egui()) {
+        let shell = &self.shell;
+        if shell.input.dragging() || (!self.left_down && shell.egui.is_pointer_over_egui()) {
             return;
         }
-        if let Some((o, d)) = self.cursor_ray() {
+        if let Some((o, d)) = self.shell.cursor_ray() {
             self.session.hand.input.cursor(o, d);
         }
     }
 
     /// One frame; `Ok(false)` when the preview should close.
-    fn frame(&mut self, opts: &PreviewOptions) -> Result<bool> {
+    fn step_and_draw(&mut self) -> Result<bool> {
         let now = Instant::now();
         let frame_ms = (now - self.last_frame).as_secs_f64() * 1e3;
         self.last_frame = now;
@@ -407,19 +294,16 @@ impl Live {
                 }
             }),
         };
-        let input = self.egui_winit.take_egui_input(&self.window);
         let panel = &mut self.panel;
         let (mut actions, mut panel_points) = (Vec::new(), 0.0);
-        let out = self
-            .egui
-            .run_ui(input, |ui| (actions, panel_points) = panel.ui(ui, &info));
-        self.egui_winit
-            .handle_platform_output(&self.window, out.platform_output);
-        let jobs = self.egui.tessellate(out.shapes, out.pixels_per_point);
+        let panel_frame = self
+            .shell
+            .panel(|ui| (actions, panel_points) = panel.ui(ui, &info));
         for a in actions {
             self.act(a)?;
         }
-        let last = self.quitting || opts.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
+        let opts = &self.opts;
+        let last = self.shell.quitting || opts.frames.is_some_and(|n| self.frames_drawn + 1 >= n);
         let capture = self.capture_next || (last && opts.screenshot.is_some());
         let solver = self.session.body.solver();
         let mut state = BodyState::of_solver(solver, &self.session.pinned);
@@ -437,22 +321,15 @@ impl Live {
                 .collect(),
             ..RenderSettings::default()
         };
-        let (w, h) = self.gpu.size();
-        let mut view = self.camera.view(w as f32 / h.max(1) as f32);
-        // Centre the scene in the part of the window the panel leaves free.
-        let shift = panel_points * out.pixels_per_point / w.max(1) as f32;
-        view.proj = glam::Mat4::from_translation(glam::Vec3::new(shift, 0.0, 0.0)) * view.proj;
-        self.view = Some((view, (w, h)));
-        let drawn = self.gpu.draw(
+        let view = self
+            .shell
+            .view_beside(panel_points, panel_frame.pixels_per_point);
+        let drawn = self.shell.gpu.draw(
             &mut self.renderer,
             &state,
             &settings,
             &view,
-            PanelFrame {
-                jobs,
-                textures: out.textures_delta,
-                pixels_per_point: out.pixels_per_point,
-            },
+            panel_frame,
             capture,
         )?;
         let Some(image) = drawn else {
@@ -466,7 +343,7 @@ impl Live {
         });
         if capture {
             self.capture_next = false;
-            let path = match (&opts.screenshot, last) {
+            let path = match (&self.opts.screenshot, last) {
                 (Some(p), true) => p.clone(),
                 _ => PathBuf::from("screenshots").join(format!(
                     "{}_f{:05}.png",
@@ -474,22 +351,10 @@ impl Live {
                     self.session.body.solver().frame()
                 )),
             };
-            match image {
-                Some(img) => {
-                    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                        std::fs::create_dir_all(dir)
-                            .with_context(|| format!("creating {}", dir.display()))?;
-                    }
-                    img.save_png(&path)?;
-                    self.panel.message = format!("saved {}", path.display());
-                }
-                None => {
-                    let msg = "this window surface cannot be read back for screenshots; use `incise render`";
-                    if last {
-                        bail!(msg);
-                    }
-                    self.panel.message = msg.into();
-                }
+            match save_frame(image, &path) {
+                Ok(()) => self.panel.message = format!("saved {}", path.display()),
+                Err(e) if !last => self.panel.message = format!("{e:#}"),
+                Err(e) => return Err(e),
             }
         }
         Ok(!last)
@@ -506,19 +371,18 @@ impl Live {
 
     /// Open the scene at `path` in place of the current one.
     fn load_scene(&mut self, path: &Path) -> Result<()> {
-        let dev = &self.gpu.dev;
+        let dev = &self.shell.gpu.dev;
         let s = Session::load(path, self.session.device, dev)?;
         self.renderer = Renderer::new(
             &dev.device,
             &dev.queue,
-            self.gpu.format(),
+            self.shell.gpu.format(),
             s.body.solver().mesh(),
             &s.skin,
         );
         self.renderer
             .set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&s.hand.tool));
-        self.home = preview_camera(s.body.solver().mesh());
-        self.camera = self.home;
+        self.shell.set_home(preview_camera(s.body.solver().mesh()));
         self.panel.draft = s.params;
         self.session = s;
         Ok(())
@@ -542,7 +406,7 @@ impl Live {
         let Some(mode) = &mut self.exercise else {
             bail!("no exercise is open");
         };
-        let dev = &self.gpu.dev;
+        let dev = &self.shell.gpu.dev;
         let stroke = reference.then(|| mode.reference()).transpose()?;
         self.session.reload(dev)?;
         let session = &mut self.session;
@@ -589,7 +453,7 @@ impl Live {
             [done.card.width as usize, done.card.height as usize],
             &done.card.pixels,
         );
-        self.panel.result_card = Some(self.egui.load_texture(
+        self.panel.result_card = Some(self.shell.egui.load_texture(
             "result card",
             card,
             egui::TextureOptions::LINEAR,
@@ -624,7 +488,7 @@ impl Live {
                 self.panel.message = "recording dropped: the scene changed under it".into();
             }
         }
-        let dev = &self.gpu.dev;
+        let dev = &self.shell.gpu.dev;
         let result = match action {
             Action::Load(path) => self.load_scene(&path).map(|()| {
                 self.exercise = None;
@@ -640,7 +504,7 @@ impl Live {
                 .apply(params, device, dev)
                 .map(|()| "settings applied".into()),
             Action::ResetView => {
-                self.camera = self.home;
+                self.shell.camera = self.shell.home;
                 Ok(String::new())
             }
             Action::Screenshot => {
