@@ -15,7 +15,7 @@ use anyhow::Result;
 use incise_xr::{Overlays, RenderSettings, Renderer};
 use winit::event::ElementState;
 
-use super::camera_input::{KeyAction, preview_camera};
+use super::camera_input::preview_camera;
 use super::pick::pick_tissue;
 use super::scalpel_input::{BladeGeometry, ScalpelFeel, ScalpelInput};
 use super::window_app::{WindowContent, WindowShell, run_window, save_frame};
@@ -69,91 +69,8 @@ impl WindowContent for Live {
         &mut self.shell
     }
 
-    fn frame(&mut self) -> Result<bool> {
-        self.step_and_draw()
-    }
-
-    fn left_button(&mut self, state: ElementState) {
-        self.scalpel_button(state);
-    }
-
-    fn cursor_moved(&mut self) {
-        let ray = self.shell.cursor_ray();
-        if let Some((o, d)) = ray.filter(|_| !self.shell.input.dragging()) {
-            self.scalpel.cursor(o, d);
-        }
-    }
-
-    fn key(&mut self, action: KeyAction) {
-        if action == KeyAction::PlayPause {
-            self.playing = !self.playing;
-        }
-    }
-}
-
-impl Live {
-    fn open(mut shell: WindowShell, w: MethodWindow) -> Result<Live> {
-        let body = DrawnBody::open(&w.scene)?;
-        let renderer = renderer_for(&shell.gpu, &body);
-        let home = preview_camera(&body.render.mesh);
-        shell.set_home(home);
-        let (lo, hi) = body.render.mesh.rest_bounds();
-        let top = glam::Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z);
-        let tool = crate::scene::hand_tool::default_tool()?;
-        let scalpel = ScalpelInput::new(
-            BladeGeometry::of(&tool),
-            ScalpelFeel::default(),
-            top,
-            home.yaw + std::f32::consts::FRAC_PI_2,
-        );
-        Ok(Live {
-            shell,
-            w,
-            body,
-            renderer,
-            scalpel,
-            hand: false,
-            playing: true,
-            frames: 0,
-            message: String::new(),
-        })
-    }
-
-    /// The left button: down on the tissue takes the tool from the script and engages
-    /// it there; up lifts it.
-    fn scalpel_button(&mut self, state: ElementState) {
-        if state == ElementState::Released {
-            self.scalpel.release();
-            return;
-        }
-        let Some((o, d)) = self.shell.cursor_ray() else {
-            return;
-        };
-        let b = &self.body;
-        let hit = pick_tissue(o, d, &b.render.mesh, &b.render.cut, b.state().positions);
-        if hit.is_some() && !self.hand {
-            self.hand = true;
-            self.scalpel.take_over(self.scalpel.target_pose());
-        }
-        if !self.scalpel.press(hit) {
-            self.message = "no tissue under the cursor".into();
-        }
-    }
-
-    /// What moves the tool this frame: the scene's script until the mouse took it.
-    fn tool_input(&mut self) -> ToolInput {
-        if !self.hand {
-            return ToolInput::Script;
-        }
-        let pose = self.scalpel.advance(self.body.body.frame_dt() as f32);
-        ToolInput::Hand {
-            pose,
-            engaged: self.scalpel.cutting(),
-        }
-    }
-
     /// Step (when playing), draw, and save the last frame; `Ok(false)` to close.
-    fn step_and_draw(&mut self) -> Result<bool> {
+    fn frame(&mut self) -> Result<bool> {
         if self.playing {
             let tool = self.tool_input();
             match self.body.step(&tool) {
@@ -188,6 +105,79 @@ impl Live {
             save_frame(image, path)?;
         }
         Ok(!last)
+    }
+
+    /// The left button: down on the tissue takes the tool from the script and engages
+    /// it there; up lifts it.
+    fn left_button(&mut self, state: ElementState) {
+        if state == ElementState::Released {
+            self.scalpel.release();
+            return;
+        }
+        let Some((o, d)) = self.shell.cursor_ray() else {
+            return;
+        };
+        let b = &self.body;
+        let hit = pick_tissue(o, d, &b.render.mesh, &b.render.cut, b.state().positions);
+        if hit.is_some() && !self.hand {
+            self.hand = true;
+            self.scalpel.take_over(self.scalpel.target_pose());
+        }
+        if !self.scalpel.press(hit) {
+            self.message = "no tissue under the cursor".into();
+        }
+    }
+
+    fn cursor_moved(&mut self) {
+        let ray = self.shell.cursor_ray();
+        if let Some((o, d)) = ray.filter(|_| !self.shell.input.dragging()) {
+            self.scalpel.cursor(o, d);
+        }
+    }
+
+    fn playing(&mut self) -> &mut bool {
+        &mut self.playing
+    }
+}
+
+impl Live {
+    fn open(mut shell: WindowShell, w: MethodWindow) -> Result<Live> {
+        let body = DrawnBody::open(&w.scene)?;
+        let renderer = renderer_for(&shell.gpu, &body);
+        let home = preview_camera(&body.render.mesh);
+        shell.set_home(home);
+        let (lo, hi) = body.render.mesh.rest_bounds();
+        let top = glam::Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z);
+        let tool = crate::scene::hand_tool::default_tool()?;
+        let scalpel = ScalpelInput::new(
+            BladeGeometry::of(&tool),
+            ScalpelFeel::default(),
+            top,
+            home.yaw + std::f32::consts::FRAC_PI_2,
+        );
+        Ok(Live {
+            shell,
+            w,
+            body,
+            renderer,
+            scalpel,
+            hand: false,
+            playing: true,
+            frames: 0,
+            message: String::new(),
+        })
+    }
+
+    /// What moves the tool this frame: the scene's script until the mouse took it.
+    fn tool_input(&mut self) -> ToolInput {
+        if !self.hand {
+            return ToolInput::Script;
+        }
+        let pose = self.scalpel.advance(self.body.body.frame_dt() as f32);
+        ToolInput::Hand {
+            pose,
+            engaged: self.scalpel.cutting(),
+        }
     }
 
     /// The side panel: scene, method, heat-map quantity, localisation, frame, play/pause.

@@ -29,7 +29,7 @@ use crate::pictures::screenshots::{ImageSize, Screenshots, stress_scale};
 use crate::sim_body::{Body, DeviceChoice};
 
 use crate::exercise::LiveExercise;
-use camera_input::{KeyAction, preview_camera, wheel_steps};
+use camera_input::{preview_camera, wheel_steps};
 use frame_times::{FrameTime, FrameTimes};
 use panel::{Action, ExerciseInfo, Panel, PanelInfo, ScalpelInfo};
 use session::{Session, scene_files};
@@ -119,142 +119,8 @@ impl WindowContent for Live {
         &mut self.shell
     }
 
-    fn frame(&mut self) -> Result<bool> {
-        self.step_and_draw()
-    }
-
-    fn left_button(&mut self, state: ElementState) {
-        self.scalpel_button(state);
-    }
-
-    fn cursor_moved(&mut self) {
-        self.scalpel_cursor();
-    }
-
-    fn key(&mut self, action: KeyAction) {
-        if action == KeyAction::PlayPause {
-            self.panel.playing = !self.panel.playing;
-        }
-    }
-
-    /// With the left button down or Ctrl held the wheel sets the cut depth; else it zooms.
-    fn wheel(&mut self, delta: MouseScrollDelta) {
-        if self.left_down || self.ctrl {
-            self.session.hand.input.wheel(wheel_steps(delta));
-        } else {
-            self.shell.input.wheel(&mut self.shell.camera, delta);
-        }
-    }
-
-    fn modifiers(&mut self, m: ModifiersState) {
-        self.ctrl = m.control_key();
-    }
-}
-
-impl Live {
-    fn open(mut shell: WindowShell, opts: PreviewOptions) -> Result<Live> {
-        let gpu = &shell.gpu;
-        let device = match opts.device {
-            // A software adapter runs the CPU solver faster than its own compute.
-            DeviceChoice::Auto => {
-                let (pick, why) = crate::sim_body::auto_device(&gpu.dev.info);
-                eprintln!("note: {why}");
-                pick
-            }
-            d => d,
-        };
-        let exercise = opts
-            .exercise
-            .as_deref()
-            .map(LiveExercise::open)
-            .transpose()?;
-        let scene = exercise
-            .as_ref()
-            .map_or(opts.scene.clone(), |e| e.scene_path().to_path_buf());
-        let mut session = Session::load(&scene, device, &gpu.dev)?;
-        if exercise.is_some() {
-            // The mouse holds the blade: the scene's own stroke would cut the plan.
-            session
-                .hand
-                .take_mouse(0, session.body.solver().params().frame_dt as f64);
-        }
-        let mut renderer = Renderer::new(
-            &gpu.dev.device,
-            &gpu.dev.queue,
-            gpu.format(),
-            session.body.solver().mesh(),
-            &session.skin,
-        );
-        renderer.set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&session.hand.tool));
-        shell.set_home(preview_camera(session.body.solver().mesh()));
-        let scene_dir = scene
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        Ok(Live {
-            panel: Panel {
-                scenes: scene_files(scene_dir),
-                playing: true,
-                draft: session.params,
-                device,
-                overlays: Default::default(),
-                message: String::new(),
-                stroke_file: "out/preview_stroke.ron".into(),
-                exercises: scene_files(&scene_dir.join("exercises")),
-                result_card: None,
-                show_result: false,
-            },
-            exercise,
-            shell,
-            opts,
-            session,
-            renderer,
-            times: FrameTimes::default(),
-            last_frame: Instant::now(),
-            frames_drawn: 0,
-            capture_next: false,
-            left_down: false,
-            ctrl: false,
-        })
-    }
-
-    /// The left button: down on the tissue starts a cut there (the mouse takes the blade
-    /// from the scene's stroke), up lifts the blade.
-    fn scalpel_button(&mut self, state: ElementState) {
-        if state == ElementState::Released {
-            self.session.hand.input.release();
-            self.left_down = false;
-            return;
-        }
-        let Some((o, d)) = self.shell.cursor_ray() else {
-            return;
-        };
-        let solver = self.session.body.solver();
-        let hit = pick::pick_tissue(o, d, solver.mesh(), solver.cut(), solver.positions());
-        let (frame, dt) = (solver.frame(), solver.params().frame_dt as f64);
-        if hit.is_some() {
-            self.session.hand.take_mouse(frame, dt);
-        }
-        self.left_down = self.session.hand.input.press(hit);
-        if !self.left_down {
-            self.panel.message = "no tissue under the cursor".into();
-        }
-    }
-
-    /// The cursor moved: the blade follows on its plane (not while the camera is dragged,
-    /// nor over the panel unless cutting).
-    fn scalpel_cursor(&mut self) {
-        let shell = &self.shell;
-        if shell.input.dragging() || (!self.left_down && shell.egui.is_pointer_over_egui()) {
-            return;
-        }
-        if let Some((o, d)) = self.shell.cursor_ray() {
-            self.session.hand.input.cursor(o, d);
-        }
-    }
-
     /// One frame; `Ok(false)` when the preview should close.
-    fn step_and_draw(&mut self) -> Result<bool> {
+    fn frame(&mut self) -> Result<bool> {
         let now = Instant::now();
         let frame_ms = (now - self.last_frame).as_secs_f64() * 1e3;
         self.last_frame = now;
@@ -358,6 +224,130 @@ impl Live {
             }
         }
         Ok(!last)
+    }
+
+    /// The left button: down on the tissue starts a cut there (the mouse takes the blade
+    /// from the scene's stroke), up lifts the blade.
+    fn left_button(&mut self, state: ElementState) {
+        if state == ElementState::Released {
+            self.session.hand.input.release();
+            self.left_down = false;
+            return;
+        }
+        let Some((o, d)) = self.shell.cursor_ray() else {
+            return;
+        };
+        let solver = self.session.body.solver();
+        let hit = pick::pick_tissue(o, d, solver.mesh(), solver.cut(), solver.positions());
+        let (frame, dt) = (solver.frame(), solver.params().frame_dt as f64);
+        if hit.is_some() {
+            self.session.hand.take_mouse(frame, dt);
+        }
+        self.left_down = self.session.hand.input.press(hit);
+        if !self.left_down {
+            self.panel.message = "no tissue under the cursor".into();
+        }
+    }
+
+    fn cursor_moved(&mut self) {
+        self.scalpel_cursor();
+    }
+
+    fn playing(&mut self) -> &mut bool {
+        &mut self.panel.playing
+    }
+
+    /// With the left button down or Ctrl held the wheel sets the cut depth; else it zooms.
+    fn wheel(&mut self, delta: MouseScrollDelta) {
+        if self.left_down || self.ctrl {
+            self.session.hand.input.wheel(wheel_steps(delta));
+        } else {
+            self.shell.input.wheel(&mut self.shell.camera, delta);
+        }
+    }
+
+    fn modifiers(&mut self, m: ModifiersState) {
+        self.ctrl = m.control_key();
+    }
+}
+
+impl Live {
+    fn open(mut shell: WindowShell, opts: PreviewOptions) -> Result<Live> {
+        let gpu = &shell.gpu;
+        let device = match opts.device {
+            // A software adapter runs the CPU solver faster than its own compute.
+            DeviceChoice::Auto => {
+                let (pick, why) = crate::sim_body::auto_device(&gpu.dev.info);
+                eprintln!("note: {why}");
+                pick
+            }
+            d => d,
+        };
+        let exercise = opts
+            .exercise
+            .as_deref()
+            .map(LiveExercise::open)
+            .transpose()?;
+        let scene = exercise
+            .as_ref()
+            .map_or(opts.scene.clone(), |e| e.scene_path().to_path_buf());
+        let mut session = Session::load(&scene, device, &gpu.dev)?;
+        if exercise.is_some() {
+            // The mouse holds the blade: the scene's own stroke would cut the plan.
+            session
+                .hand
+                .take_mouse(0, session.body.solver().params().frame_dt as f64);
+        }
+        let mut renderer = Renderer::new(
+            &gpu.dev.device,
+            &gpu.dev.queue,
+            gpu.format(),
+            session.body.solver().mesh(),
+            &session.skin,
+        );
+        renderer.set_tool_mesh(&crate::pictures::tool_view::tool_mesh(&session.hand.tool));
+        shell.set_home(preview_camera(session.body.solver().mesh()));
+        let scene_dir = scene
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        Ok(Live {
+            panel: Panel {
+                scenes: scene_files(scene_dir),
+                playing: true,
+                draft: session.params,
+                device,
+                overlays: Default::default(),
+                message: String::new(),
+                stroke_file: "out/preview_stroke.ron".into(),
+                exercises: scene_files(&scene_dir.join("exercises")),
+                result_card: None,
+                show_result: false,
+            },
+            exercise,
+            shell,
+            opts,
+            session,
+            renderer,
+            times: FrameTimes::default(),
+            last_frame: Instant::now(),
+            frames_drawn: 0,
+            capture_next: false,
+            left_down: false,
+            ctrl: false,
+        })
+    }
+
+    /// The cursor moved: the blade follows on its plane (not while the camera is dragged,
+    /// nor over the panel unless cutting).
+    fn scalpel_cursor(&mut self) {
+        let shell = &self.shell;
+        if shell.input.dragging() || (!self.left_down && shell.egui.is_pointer_over_egui()) {
+            return;
+        }
+        if let Some((o, d)) = self.shell.cursor_ray() {
+            self.session.hand.input.cursor(o, d);
+        }
     }
 
     /// Simulate one frame (kept for the exercise attempt under way); its time, ms.

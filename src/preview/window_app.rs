@@ -127,7 +127,8 @@ impl WindowShell {
         self.cursor = Some((x, y));
     }
 
-    /// F toggles fullscreen, Escape asks for a last frame; other actions are the content's.
+    /// F toggles fullscreen, Escape asks for a last frame; the rest (play/pause) is the
+    /// content's.
     fn key(&mut self, key: &winit::keyboard::Key) -> KeyAction {
         match self.input.key(&mut self.camera, &self.home, key) {
             KeyAction::Fullscreen => {
@@ -162,8 +163,8 @@ pub trait WindowContent {
     /// The cursor moved (the shell has its position and the camera drag).
     fn cursor_moved(&mut self);
 
-    /// A key asked for `action` beyond the camera (play/pause).
-    fn key(&mut self, action: KeyAction);
+    /// Whether the simulation plays (Space toggles it).
+    fn playing(&mut self) -> &mut bool;
 
     /// The wheel turned: zoom by default.
     fn wheel(&mut self, delta: MouseScrollDelta) {
@@ -272,10 +273,12 @@ impl<C: WindowContent, F: FnOnce(WindowShell) -> Result<C>> ApplicationHandler f
             }
             WindowEvent::MouseWheel { delta, .. } if !consumed => content.wheel(delta),
             WindowEvent::KeyboardInput { event, .. }
-                if !consumed && event.state == ElementState::Pressed =>
+                if !consumed
+                    && event.state == ElementState::Pressed
+                    && shell.key(&event.logical_key) == KeyAction::PlayPause =>
             {
-                let action = shell.key(&event.logical_key);
-                content.key(action);
+                let playing = content.playing();
+                *playing = !*playing;
             }
             _ => {}
         }
