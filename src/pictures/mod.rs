@@ -1,6 +1,10 @@
 //! Pictures of a body: a body of any method as the renderer draws it, offscreen
-//! screenshots and what the renderer is told of the scalpel.
+//! screenshots (of the XPBD solver, and of any method's tet views) and what the renderer
+//! is told of the scalpel.
 
 pub mod drawn_body;
+pub mod run_pictures;
 pub mod screenshots;
+pub mod tet_drawing;
 pub mod tool_view;
+pub mod view_pictures;

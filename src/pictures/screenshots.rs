@@ -207,6 +207,9 @@ pub fn render_frame(
     device: DeviceChoice,
 ) -> Result<()> {
     let scene = crate::scene::load_scene(scene_path)?;
+    if !matches!(scene.model, crate::scene::ModelChoice::Xpbd) {
+        return render_view_frame(&scene, scene_path, frame, out, size, overlays(overlay));
+    }
     let built = crate::scene::build_scene(&scene, scene_path, None)?;
     let dev = RenderDevice::headless()
         .map_err(|e| anyhow!("{e}"))
@@ -233,8 +236,42 @@ pub fn render_frame(
         body.step_frame()
             .with_context(|| format!("{}: frame {f}", scene_path.display()))?;
     }
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+    create_parent(out)?;
+    shots.save(&body, out)
+}
+
+/// `incise render` of a scene of another method than XPBD: its body stepped `frame`
+/// frames by the scene's own script, drawn from its tet view with `overlays` (`stress`:
+/// the heat map of the method's quantity).
+fn render_view_frame(
+    scene: &crate::scene::Scene,
+    scene_path: &Path,
+    frame: u64,
+    out: &Path,
+    size: ImageSize,
+    overlays: Overlays,
+) -> Result<()> {
+    let opts = crate::sim_body::OpenOptions {
+        device: DeviceChoice::Cpu,
+        quiet: true,
+        ..Default::default()
+    };
+    let (mut body, _) = crate::sim_body::open(scene, scene_path, &opts)?;
+    let mut pictures = super::view_pictures::ViewPictures::new(size, overlays)?;
+    // The first picture fixes the camera on the body at rest, as for an XPBD scene.
+    pictures.image(body.tet_view())?;
+    for f in 0..frame {
+        body.step(&crate::sim_body::ToolInput::Script)
+            .with_context(|| format!("{}: frame {f}", scene_path.display()))?;
+    }
+    create_parent(out)?;
+    pictures.save(body.tet_view(), out)
+}
+
+/// Make the folder `path` is to be written in.
+fn create_parent(path: &Path) -> Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    shots.save(&body, out)
+    Ok(())
 }

@@ -90,7 +90,7 @@ impl WindowContent for Live {
                 stress: true,
                 ..Overlays::default()
             },
-            stress_max: self.body.scale,
+            stress_max: self.body.drawing.scale,
             ..RenderSettings::default()
         };
         let view = self.shell.view_beside(panel_points, panel.pixels_per_point);
@@ -118,7 +118,13 @@ impl WindowContent for Live {
             return;
         };
         let b = &self.body;
-        let hit = pick_tissue(o, d, &b.render.mesh, &b.render.cut, b.state().positions);
+        let hit = pick_tissue(
+            o,
+            d,
+            &b.drawing.render.mesh,
+            &b.drawing.render.cut,
+            b.state().positions,
+        );
         if hit.is_some() && !self.hand {
             self.hand = true;
             self.scalpel.take_over(self.scalpel.target_pose());
@@ -144,9 +150,9 @@ impl Live {
     fn open(mut shell: WindowShell, w: MethodWindow) -> Result<Live> {
         let body = DrawnBody::open(&w.scene)?;
         let renderer = renderer_for(&shell.gpu, &body);
-        let home = preview_camera(&body.render.mesh);
+        let home = preview_camera(&body.drawing.render.mesh);
         shell.set_home(home);
-        let (lo, hi) = body.render.mesh.rest_bounds();
+        let (lo, hi) = body.drawing.render.mesh.rest_bounds();
         let top = glam::Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z);
         let tool = crate::scene::hand_tool::default_tool()?;
         let scalpel = ScalpelInput::new(
@@ -200,7 +206,7 @@ impl Live {
                     if let Some(q) = quantity {
                         ui.label(format!(
                             "heat map: {} (0 – {:.3e} {})",
-                            q.name, body.scale, q.unit
+                            q.name, body.drawing.scale, q.unit
                         ));
                     }
                     for line in &live_lines {
@@ -221,7 +227,7 @@ impl Live {
 
 /// A renderer for the body's current topology.
 fn renderer_for(gpu: &WindowGpu, body: &DrawnBody) -> Renderer {
-    let r = &body.render;
+    let r = &body.drawing.render;
     Renderer::new(
         &gpu.dev.device,
         &gpu.dev.queue,

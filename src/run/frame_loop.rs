@@ -12,7 +12,7 @@ use incise_sim::io::write_pvd;
 
 use super::ending::RunEnd;
 use super::options::{CHECKPOINT_FRAMES, RunOptions};
-use crate::pictures::screenshots::Screenshots;
+use crate::pictures::run_pictures::RunPictures;
 use crate::progress::Progress;
 use crate::report::{FrameData, FrameRecord, Report};
 use crate::sim_body::{Fault, SimBody, StepError, ToolInput};
@@ -23,7 +23,7 @@ pub struct FrameLoop<'o> {
     body: Box<dyn SimBody>,
     report: Report,
     pvd: Vec<(f64, String)>,
-    shots: Option<Screenshots>,
+    shots: Option<RunPictures>,
     recorder: Option<StrokeRecorder>,
     progress: Option<Progress>,
     haptic: HapticCurve,

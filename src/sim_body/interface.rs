@@ -7,10 +7,13 @@ use std::path::Path;
 
 pub use super::method::Method;
 use crate::exercise::PlanDecal;
-use crate::pictures::screenshots::{ImageSize, Screenshots};
+use crate::pictures::run_pictures::RunPictures;
+use crate::pictures::screenshots::ImageSize;
+use crate::pictures::view_pictures::ViewPictures;
 use crate::report::{FrameData, Report};
 use glam::Vec3;
 use incise_sim::contact::ToolPose;
+use incise_xr::Overlays;
 
 /// What moves the tool in the frame being stepped.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -161,23 +164,37 @@ pub trait SimBody {
     /// run prints at its end, where the method has one.
     fn finish(&mut self, report: &mut Report) -> anyhow::Result<Option<String>>;
 
-    /// An offscreen renderer of `size` for this body with its tool and `decal` (an
-    /// exercise's plan) drawn; an error for a method the renderer cannot draw yet.
+    /// An offscreen renderer of `size` for this body (its tool and `decal`, an exercise's
+    /// plan, drawn on XPBD bodies): by default, pictures of its tet view with the heat map
+    /// of its quantity.
     fn screenshots(
         &self,
         size: ImageSize,
         decal: Option<&PlanDecal>,
-    ) -> anyhow::Result<Screenshots> {
-        let _ = (size, decal);
-        anyhow::bail!(
-            "offscreen pictures draw XPBD bodies only so far; this body's method is {}",
-            self.method().name()
-        )
+    ) -> anyhow::Result<RunPictures> {
+        if decal.is_some() {
+            anyhow::bail!(
+                "an exercise's plan is drawn on XPBD bodies only; this body's method is {}",
+                self.method().name()
+            );
+        }
+        let heat_map = Overlays {
+            stress: true,
+            ..Overlays::default()
+        };
+        Ok(RunPictures::Views(Box::new(ViewPictures::new(
+            size, heat_map,
+        )?)))
     }
 
     /// Draw the body now with `shots` (from [`SimBody::screenshots`]) into the PNG `path`.
-    fn screenshot(&self, shots: &mut Screenshots, path: &Path) -> anyhow::Result<()> {
-        let _ = (shots, path);
-        anyhow::bail!("{} bodies have no offscreen pictures", self.method().name())
+    fn screenshot(&self, shots: &mut RunPictures, path: &Path) -> anyhow::Result<()> {
+        match shots {
+            RunPictures::Views(v) => v.save(self.tet_view(), path),
+            RunPictures::Solver(_) => anyhow::bail!(
+                "XPBD screenshots cannot draw a {} body",
+                self.method().name()
+            ),
+        }
     }
 }

@@ -18,6 +18,7 @@ use super::interface::{
 use super::vertex_field::vertex_mean;
 use super::xpbd_device::Body;
 use crate::exercise::PlanDecal;
+use crate::pictures::run_pictures::RunPictures;
 use crate::pictures::screenshots::{ImageSize, Screenshots};
 use crate::report::{FrameData, MaterialInfo, MeshInfo, Report, ToolInfo};
 use crate::scene::{BuiltScene, SceneTool, ToolDriver, build_scene_driven};
@@ -282,7 +283,7 @@ impl SimBody for XpbdBody {
         Ok(None)
     }
 
-    fn screenshots(&self, size: ImageSize, decal: Option<&PlanDecal>) -> Result<Screenshots> {
+    fn screenshots(&self, size: ImageSize, decal: Option<&PlanDecal>) -> Result<RunPictures> {
         let shots = Screenshots::new(
             None,
             self.body.solver(),
@@ -294,14 +295,17 @@ impl SimBody for XpbdBody {
             Some(t) => shots.with_tool(&t.tool),
             None => shots,
         };
-        Ok(match decal {
+        Ok(RunPictures::Solver(Box::new(match decal {
             Some(d) => shots.with_decal(d.clone()),
             None => shots,
-        })
+        })))
     }
 
-    fn screenshot(&self, shots: &mut Screenshots, path: &Path) -> Result<()> {
-        shots.save(&self.body, path)
+    fn screenshot(&self, shots: &mut RunPictures, path: &Path) -> Result<()> {
+        match shots {
+            RunPictures::Solver(s) => s.save(&self.body, path),
+            RunPictures::Views(v) => v.save(self.tet_view(), path),
+        }
     }
 }
 

@@ -42,7 +42,7 @@ pub fn run_simulated(scene: &Path, script_path: &Path, out: &Path) -> Result<Str
     let script = HeadsetScript::load(script_path)?;
     let dev = RenderDevice::headless()?;
     let body = DrawnBody::open(scene)?;
-    let (lo, hi) = body.render.mesh.rest_bounds();
+    let (lo, hi) = body.drawing.render.mesh.rest_bounds();
     let tray = Tray::for_bounds(lo, hi);
     let stroke = tool_stroke(&script, script_path)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -149,7 +149,7 @@ impl Session {
                 stress: true,
                 ..Overlays::default()
             },
-            stress_max: self.body.scale,
+            stress_max: self.body.drawing.scale,
             background,
             background_alpha,
             ..RenderSettings::default()
@@ -188,6 +188,6 @@ impl Session {
 
 /// A renderer for the body's current topology.
 fn renderer_for(dev: &RenderDevice, format: wgpu::TextureFormat, body: &DrawnBody) -> Renderer {
-    let r = &body.render;
+    let r = &body.drawing.render;
     Renderer::new(&dev.device, &dev.queue, format, &r.mesh, &r.skin)
 }

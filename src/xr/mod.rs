@@ -164,7 +164,7 @@ fn run_method(opts: &XrOptions) -> Result<String> {
     }
     let mut session = open_session(&opts.scene)?;
     let body = crate::pictures::drawn_body::DrawnBody::open(&opts.scene)?;
-    let (lo, hi) = body.render.mesh.rest_bounds();
+    let (lo, hi) = body.drawing.render.mesh.rest_bounds();
     method_session::run_on(
         &mut session,
         &opts.scene,

@@ -1,0 +1,74 @@
+//! Offscreen pictures of a body of any method, drawn from its [`TetView`] as the preview
+//! draws it: the current topology's skin and cut faces, the heat map of the method's own
+//! quantity, and a fixed camera framing the first picture's body.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use incise_xr::{OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View};
+
+use super::screenshots::{ImageSize, default_camera};
+use super::tet_drawing::TetDrawing;
+use crate::sim_body::TetView;
+
+/// An offscreen renderer of a body's tet views, rebuilt when a cut changes the tets.
+pub struct ViewPictures {
+    dev: RenderDevice,
+    size: ImageSize,
+    overlays: Overlays,
+    drawing: Option<TetDrawing>,
+    offscreen: Option<OffscreenRenderer>,
+    camera: Option<View>,
+}
+
+impl ViewPictures {
+    /// Pictures of `size` with `overlays` (the heat map is the stress overlay) on a new
+    /// headless render device.
+    pub fn new(size: ImageSize, overlays: Overlays) -> Result<ViewPictures> {
+        let dev = RenderDevice::headless().context("offscreen pictures draw with wgpu")?;
+        Ok(ViewPictures {
+            dev,
+            size,
+            overlays,
+            drawing: None,
+            offscreen: None,
+            camera: None,
+        })
+    }
+
+    /// Draw `view` now.
+    pub fn image(&mut self, view: TetView) -> Result<RgbaImage> {
+        let (d, rebuilt) = match self.drawing.take() {
+            Some(mut d) => {
+                let changed = d.update(view)?;
+                (d, changed)
+            }
+            None => (TetDrawing::new(view)?, true),
+        };
+        let d = self.drawing.insert(d);
+        let off = match self.offscreen.take().filter(|_| !rebuilt) {
+            Some(off) => off,
+            None => {
+                let (mesh, skin) = (&d.render.mesh, &d.render.skin);
+                OffscreenRenderer::new(&self.dev, mesh, skin, (self.size.0, self.size.1), 1)?
+            }
+        };
+        let off = self.offscreen.insert(off);
+        let camera = *self
+            .camera
+            .get_or_insert_with(|| default_camera(&d.render.mesh).view(off.aspect()));
+        let settings = RenderSettings {
+            overlays: self.overlays,
+            stress_max: d.scale,
+            ..RenderSettings::default()
+        };
+        Ok(off.render_image(&d.state(), &settings, &camera)?)
+    }
+
+    /// Draw `view` now and write the PNG to `path`.
+    pub fn save(&mut self, view: TetView, path: &Path) -> Result<()> {
+        self.image(view)?
+            .save_png(path)
+            .with_context(|| format!("writing screenshot {}", path.display()))
+    }
+}
