@@ -72,7 +72,7 @@ pub fn build_scene_driven(
     };
     if let Some(model) = model {
         return Err(anyhow!(
-            "{}: model {model} runs with `incise run` only; this command needs an Xpbd scene",
+            "{}: model {model} runs in `incise run`, `preview`, `xr` and `render`; this command needs an Xpbd scene",
             scene_path.display()
         ));
     }
