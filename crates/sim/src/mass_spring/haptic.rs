@@ -284,6 +284,17 @@ mod tests {
         m
     }
 
+    /// A loop dropped without `stop` (its body dropped mid-run) stops and joins its thread:
+    /// nothing holds the shared state afterwards.
+    #[test]
+    fn a_dropped_loop_stops_its_thread() {
+        let h = HapticLoop::spawn(held_slab(), HapticConfig::default());
+        let shared = Arc::downgrade(&h.shared);
+        std::thread::sleep(Duration::from_millis(5));
+        drop(h);
+        assert_eq!(shared.strong_count(), 0, "the haptic thread still runs");
+    }
+
     /// The tool's path in 1 kHz loops, run through [`ToolCoupling::haptic_loop`] without a thread:
     /// the force on the tool each loop.
     fn drive(m: &mut MassSpringModel, contact: HapticContact, path: &[DVec3]) -> Vec<DVec3> {
