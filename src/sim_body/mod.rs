@@ -2,6 +2,7 @@
 //! on its device, the Nakao mass-spring cutter (frame by frame or at a haptic rate) and
 //! the three-element rheological body, side by side; [`open`] opens a scene's.
 
+pub mod edge_report;
 pub mod interface;
 pub mod method;
 pub mod nakao;

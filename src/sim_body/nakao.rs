@@ -10,7 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use glam::{DVec3, Quat, Vec3};
+use glam::{DVec3, Vec3};
 use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::mass_spring::{
@@ -225,10 +225,7 @@ impl SimBody for NakaoBody {
     }
 
     fn tool_pose(&self) -> Option<ToolPose> {
-        self.pose.map(|p| ToolPose {
-            position: p.tip.as_vec3(),
-            rotation: Quat::IDENTITY,
-        })
+        super::nakao_blade::tool_pose(self.pose)
     }
 
     fn tool_force(&self) -> Option<Vec3> {

@@ -9,7 +9,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
-use glam::{DVec3, Quat, Vec3};
+use glam::{DVec3, Vec3};
 use incise_sim::contact::ToolPose;
 use incise_sim::mass_spring::{HapticConfig, HapticLoop, LocalLoopParams, MassSpringModel};
 use incise_sim::nakao_cut::BladePose;
@@ -149,10 +149,7 @@ impl SimBody for NakaoHapticBody {
     }
 
     fn tool_pose(&self) -> Option<ToolPose> {
-        self.pose.map(|p| ToolPose {
-            position: p.tip.as_vec3(),
-            rotation: Quat::IDENTITY,
-        })
+        super::nakao_blade::tool_pose(self.pose)
     }
 
     fn tool_force(&self) -> Option<Vec3> {
