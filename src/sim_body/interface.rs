@@ -6,6 +6,7 @@
 use std::path::Path;
 
 pub use super::method::Method;
+use super::outcome::Outcome;
 use crate::exercise::PlanDecal;
 use crate::pictures::screenshots::{ImageSize, Screenshots};
 use crate::report::{FrameData, Report};
@@ -146,6 +147,10 @@ pub trait SimBody {
     /// After [`StepError::DeviceLost`]: the body on the CPU from its last completed frame
     /// (a body that runs on the CPU already stays as it is).
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody>;
+
+    /// The body's result now, in its method's terms, for checking that a replay or a
+    /// rollback reproduces it bit for bit (`None`: a haptic thread holds the state).
+    fn outcome(&self) -> Option<Outcome>;
 
     /// Inject `fault` (testing aid); an error when the method has no such fault.
     fn inject(&mut self, fault: Fault) -> anyhow::Result<()>;

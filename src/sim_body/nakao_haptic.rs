@@ -16,6 +16,7 @@ use incise_sim::nakao_cut::BladePose;
 
 use super::interface::{Fault, Method, SimBody, StepError, Surface, TetView, ToolInput};
 use super::nakao_blade::Blade;
+use super::outcome::Outcome;
 use crate::report::{EdgeFrameStats, FrameData, HapticInfo, Report};
 use crate::scene::{Localisation, MassSpringScene, StrokeSpec};
 
@@ -204,6 +205,13 @@ impl SimBody for NakaoHapticBody {
 
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody> {
         self
+    }
+
+    fn outcome(&self) -> Option<Outcome> {
+        match &self.holder {
+            Holder::Here(m) => Some(super::nakao_outcome::model_outcome(m)),
+            _ => None,
+        }
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {

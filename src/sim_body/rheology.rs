@@ -16,6 +16,7 @@ use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::rheology::{FlatIndenter, PressSchedule, RheologyBody as Model};
 
 use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
+use super::outcome::{Outcome, StateHash};
 use crate::report::{EdgeFrameStats, FrameData, Report};
 use crate::scene::IndenterSpec;
 
@@ -303,6 +304,19 @@ impl SimBody for RheologyBody {
 
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody> {
         self
+    }
+
+    fn outcome(&self) -> Option<Outcome> {
+        let n = self.model.node_count();
+        let mut h = StateHash::new();
+        h.reals([self.model.time()])
+            .vectors(&self.model.positions())
+            .vectors(&(0..n).map(|i| self.model.velocity(i)).collect::<Vec<_>>());
+        Some(Outcome {
+            summary: format!("dent {:.4} mm", self.dent() * 1e3),
+            hash: h.finish(),
+            released: None,
+        })
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {

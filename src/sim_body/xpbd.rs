@@ -15,6 +15,7 @@ use incise_sim::xpbd::SolverError;
 use super::interface::{
     Fault, Method, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
 };
+use super::outcome::{Outcome, StateHash};
 use super::vertex_field::vertex_mean;
 use super::xpbd_device::Body;
 use crate::exercise::PlanDecal;
@@ -266,6 +267,17 @@ impl SimBody for XpbdBody {
         })
     }
 
+    fn outcome(&self) -> Option<Outcome> {
+        let released = released_tets(self.body.solver());
+        Some(Outcome {
+            summary: format!("{} tets released", released.len()),
+            hash: StateHash::new()
+                .ints(released.iter().map(|&t| u64::from(t)))
+                .finish(),
+            released: Some(released.len()),
+        })
+    }
+
     fn inject(&mut self, fault: Fault) -> Result<()> {
         match fault {
             Fault::Nan => self.body.inject_nan(),
@@ -275,10 +287,7 @@ impl SimBody for XpbdBody {
     }
 
     fn finish(&mut self, report: &mut Report) -> Result<Option<String>> {
-        let cut = self.body.solver().cut();
-        report.released_tets = (0..self.body.solver().mesh().tet_count() as u32)
-            .filter(|&t| !cut.is_live(t as usize))
-            .collect();
+        report.released_tets = released_tets(self.body.solver());
         Ok(None)
     }
 
@@ -303,6 +312,14 @@ impl SimBody for XpbdBody {
     fn screenshot(&self, shots: &mut Screenshots, path: &Path) -> Result<()> {
         shots.save(&self.body, path)
     }
+}
+
+/// The tets `solver` has released, in index order.
+pub fn released_tets(solver: &Solver) -> Vec<u32> {
+    let cut = solver.cut();
+    (0..solver.mesh().tet_count() as u32)
+        .filter(|&t| !cut.is_live(t as usize))
+        .collect()
 }
 
 /// Write `solver`'s state as a `.vtu` at `path`: per tet von Mises stress and released,
