@@ -95,6 +95,9 @@ pub struct OpenOptions {
     pub threads: Option<usize>,
     /// Where the XPBD solver runs.
     pub device: crate::sim_body::xpbd_device::DeviceChoice,
+    /// An open GPU context to put an XPBD solver on when `device` asks for the GPU (a
+    /// soak keeps one across its resets); `None`: one is opened for the body.
+    pub gpu: Option<incise_sim::gpu::GpuContext>,
     /// Drive the scene's tool with this stroke file instead of the scene's stroke (XPBD).
     pub stroke: Option<std::path::PathBuf>,
     /// Run a Nakao scene's local loop on its own thread at this rate, Hz (PHYSICS.md §2.6).

@@ -75,7 +75,9 @@ pub fn open(
     let mut report = skeleton(scene, path, &built, tool.as_ref());
     let mut choice = None;
     let BuiltScene { solver, skin, .. } = built;
-    let body = Body::place(solver, opts.device, |m| choice = Some(m.to_string()))?;
+    let body = Body::place_on(solver, opts.device, opts.gpu.as_ref(), |m| {
+        choice = Some(m.to_string())
+    })?;
     if let Some(m) = choice.as_ref().filter(|_| !opts.quiet) {
         eprintln!("note: {m}");
     }
