@@ -192,6 +192,20 @@ fn main() -> ExitCode {
             bench::BenchOutput::of(json, markdown),
         ),
         Command::Bench {
+            target: BenchTarget::Scene,
+            json,
+            frames,
+            device,
+            scene,
+            markdown,
+            ..
+        } => bench::scene::run(
+            &scene,
+            device,
+            frames,
+            bench::BenchOutput::of(json, markdown),
+        ),
+        Command::Bench {
             target: BenchTarget::Solver,
             json,
             frames,
