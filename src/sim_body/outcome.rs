@@ -14,7 +14,7 @@ pub struct Outcome {
     /// The result in words, e.g. "412 tets released", "1410 nodes, 3721 tets".
     pub summary: String,
     /// A hash of the bits the method's result is judged by (XPBD: the released tets; Nakao:
-    /// the whole model; rheology: positions, velocities and time).
+    /// the whole model; rheology: positions, velocities, Voigt ratios and time).
     pub hash: u64,
     /// Tets released so far (XPBD only).
     pub released: Option<usize>,
