@@ -166,8 +166,8 @@ fn cut_once(scene_path: &Path, opts: &OpenOptions) -> Result<Cut> {
 
 /// How each cut's body is opened: quietly, on one GPU context for every cut when the
 /// scene is XPBD and the device may be the GPU (`auto` without an adapter: the CPU).
-fn open_options(scene: &Path, device: DeviceChoice) -> Result<OpenOptions> {
-    let xpbd = matches!(load_scene(scene)?.model, ModelChoice::Xpbd);
+fn open_options(scene: &Scene, device: DeviceChoice) -> Result<OpenOptions> {
+    let xpbd = matches!(scene.model, ModelChoice::Xpbd);
     let (device, gpu) = match device {
         DeviceChoice::Gpu if xpbd => (device, Some(gpu_context()?)),
         DeviceChoice::Auto if xpbd => match gpu_context() {
@@ -187,22 +187,51 @@ fn open_options(scene: &Path, device: DeviceChoice) -> Result<OpenOptions> {
 /// Run the soak; writes `out/soak.json` and returns the report (`passed` says the verdict).
 pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
     let start = Instant::now();
-    let budget = Duration::from_secs_f64(opts.seconds.max(0.0));
-    let mut cycles = Vec::new();
-    let mut first: Option<Outcome> = None;
-    let mut device = String::new();
-    let open_opts = open_options(&opts.scene, opts.device)?;
-    let method = match load_scene(&opts.scene)?.model {
+    let scene = load_scene(&opts.scene)?;
+    let method = match scene.model {
         ModelChoice::Xpbd => Method::Xpbd,
         ModelChoice::MassSpring(_) => Method::Nakao,
         ModelChoice::Rheology(_) => Method::Rheology,
     };
+    let (cycles, device) = cut_for(opts, &open_options(&scene, opts.device)?, start)?;
+    let verdict = judge(&cycles);
+    let report = SoakReport {
+        scene: opts.scene.display().to_string(),
+        method,
+        device,
+        seconds: start.elapsed().as_secs_f64(),
+        cycles,
+        rss_growth: verdict.rss_growth,
+        rss_peak_growth: verdict.rss_peak_growth,
+        fd_growth: verdict.fd_growth,
+        passed: verdict.problems.is_empty(),
+        problems: verdict.problems,
+    };
+    std::fs::create_dir_all(&opts.out)
+        .with_context(|| format!("creating {}", opts.out.display()))?;
+    let path = opts.out.join("soak.json");
+    incise_sim::io::write_atomic(&path, &serde_json::to_vec_pretty(&report)?)
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(report)
+}
+
+/// Cut, reset and cut again until `opts.seconds` have passed since `start` (three cuts at
+/// least); every cut, and the device of the first.
+fn cut_for(
+    opts: &SoakOptions,
+    open_opts: &OpenOptions,
+    start: Instant,
+) -> Result<(Vec<SoakCycle>, String)> {
+    let budget = Duration::from_secs_f64(opts.seconds.max(0.0));
+    let mut cycles = Vec::new();
+    let mut first: Option<Outcome> = None;
+    let mut device = String::new();
     while cycles.len() < 3 || start.elapsed() < budget {
         let Cut {
             device: dev,
             outcome,
             mut times,
-        } = cut_once(&opts.scene, &open_opts)?;
+        } = cut_once(&opts.scene, open_opts)?;
         times.sort_by(f64::total_cmp);
         let matches_first = first.as_ref().is_none_or(|f| *f == outcome);
         if first.is_none() {
@@ -222,6 +251,19 @@ pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
             matches_first,
         });
     }
+    Ok((cycles, device))
+}
+
+/// The soak's figures and what failed.
+struct Verdict {
+    rss_growth: f64,
+    rss_peak_growth: f64,
+    fd_growth: i64,
+    problems: Vec<String>,
+}
+
+/// Judge three or more `cycles`: memory, descriptors, identical results.
+fn judge(cycles: &[SoakCycle]) -> Verdict {
     // The first cut warms caches and pools (thread pools, shader compilation, allocator
     // arenas): growth counts from the end of the second.
     // Growth is what stays: the median over the last third of the later cuts (a leak
@@ -233,10 +275,9 @@ pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
     let mut tail = later[later.len() - later.len().div_ceil(3)..].to_vec();
     tail.sort_unstable();
     let rss_growth = tail[tail.len() / 2] as f64 / base - 1.0;
-    let peak = cycles[1..].iter().map(|c| c.rss_kib).max().unwrap_or(0) as f64;
-    let rss_peak_growth = peak / base - 1.0;
-    let fd_growth = cycles.last().map_or(0, |c| c.open_fds as i64) - cycles[1].open_fds as i64;
     let grown_kib = tail[tail.len() / 2] as f64 - base;
+    let peak = cycles[1..].iter().map(|c| c.rss_kib).max().unwrap_or(0) as f64;
+    let fd_growth = cycles.last().map_or(0, |c| c.open_fds as i64) - cycles[1].open_fds as i64;
     let mut problems = Vec::new();
     if rss_growth > 0.05 && grown_kib > SETTLING_KIB {
         problems.push(format!(
@@ -253,24 +294,12 @@ pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
             c.cycle, c.result, c.fingerprint, cycles[0].result, cycles[0].fingerprint
         ));
     }
-    let report = SoakReport {
-        scene: opts.scene.display().to_string(),
-        method,
-        device,
-        seconds: start.elapsed().as_secs_f64(),
-        cycles,
+    Verdict {
         rss_growth,
-        rss_peak_growth,
+        rss_peak_growth: peak / base - 1.0,
         fd_growth,
-        passed: problems.is_empty(),
         problems,
-    };
-    std::fs::create_dir_all(&opts.out)
-        .with_context(|| format!("creating {}", opts.out.display()))?;
-    let path = opts.out.join("soak.json");
-    incise_sim::io::write_atomic(&path, &serde_json::to_vec_pretty(&report)?)
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(report)
+    }
 }
 
 /// The report as one row of docs/reliability.md's soak table, under the line saying
