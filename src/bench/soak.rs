@@ -336,3 +336,46 @@ pub fn markdown(r: &SoakReport) -> String {
         p99[p99.len() / 2],
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Cycles with these resident sizes, KiB (nothing else differs).
+    fn cycles(rss: &[u64]) -> Vec<SoakCycle> {
+        rss.iter()
+            .enumerate()
+            .map(|(cycle, &rss_kib)| SoakCycle {
+                cycle,
+                rss_kib,
+                open_fds: 6,
+                frames: 30,
+                p50_ms: 1.0,
+                p99_ms: 2.0,
+                released: None,
+                result: "1274 nodes, 3510 tets".into(),
+                fingerprint: "aad658ce49cdfc81".into(),
+                matches_first: true,
+            })
+            .collect()
+    }
+
+    /// A small process settling 0.7 MB (+6 %) up passes; 1.2 MB (+11 %) fails, as does a
+    /// large relative and absolute growth.
+    #[test]
+    fn memory_growth_counts_past_five_percent_and_one_mebibyte() {
+        assert!(
+            judge(&cycles(&[12_000, 11_000, 11_700]))
+                .problems
+                .is_empty()
+        );
+        let grown = judge(&cycles(&[12_000, 11_000, 12_200]));
+        assert_eq!(grown.problems.len(), 1, "{:?}", grown.problems);
+        assert!(grown.problems[0].contains("memory grew 10.9 %"));
+        assert!(
+            !judge(&cycles(&[120_000, 110_000, 120_000]))
+                .problems
+                .is_empty()
+        );
+    }
+}
