@@ -209,7 +209,7 @@ pub enum Command {
         /// Add the intestine scaling series (≈140k, 550k, 1.1M tets).
         #[arg(long)]
         scaling: bool,
-        /// Scene of the `realtime` target.
+        /// Scene of the `realtime` and `scene` targets.
         #[arg(long, default_value = "config/intestine_pull.ron")]
         scene: PathBuf,
         /// CPU solver threads of the `realtime` target (default: all cores).
@@ -431,6 +431,9 @@ pub enum BenchTarget {
     /// The default scene at its own substeps: ms per frame split into substeps, release
     /// checks and stress; frames per second (`--scene` for another scene).
     Realtime,
+    /// The `--scene` of any method through its body's script: ms per frame, nodes and
+    /// tets, and a Nakao body's localisation levels and loop split (`--frames` frames).
+    Scene,
 }
 
 /// Benchmark case selection.

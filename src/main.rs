@@ -192,6 +192,20 @@ fn main() -> ExitCode {
             bench::BenchOutput::of(json, markdown),
         ),
         Command::Bench {
+            target: BenchTarget::Scene,
+            json,
+            frames,
+            device,
+            scene,
+            markdown,
+            ..
+        } => bench::scene::run(
+            &scene,
+            device,
+            frames,
+            bench::BenchOutput::of(json, markdown),
+        ),
+        Command::Bench {
             target: BenchTarget::Solver,
             json,
             frames,
@@ -232,7 +246,7 @@ fn main() -> ExitCode {
                 r.rss_peak_growth * 100.0,
                 r.fd_growth,
                 last.map_or(0.0, |c| c.p99_ms),
-                if r.problems.iter().any(|p| p.contains("other tets")) { "differs from" } else { "matches" },
+                if r.cycles.iter().all(|c| c.matches_first) { "matches" } else { "differs from" },
             );
             println!("report: {}", out.join("soak.json").display());
             if markdown {

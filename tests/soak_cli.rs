@@ -4,7 +4,11 @@
 //! the warm-up cut, no file descriptor leaks, every cut releases exactly the first cut's
 //! tets, and `--markdown` prints that as a table row under its provenance line.
 //! `INCISE_SOAK_SECONDS` sets a longer duration per device (it was 150 s each, the two
-//! side by side: 2.5 of CI's 30 minutes, for the same checks).
+//! side by side: 2.5 of CI's 30 minutes, for the same checks). Issue 20: the Nakao plate
+//! and the layered organ (rheology) soak too, each cut judged by its method's own result
+//! (the Nakao model's counts and state bits, the rheological body's positions and dent),
+//! on 0.3 s versions of the scenes (the Nakao blade cuts from 0.2 s, the indenter presses
+//! from 0 s).
 
 mod common;
 
@@ -66,4 +70,69 @@ fn soak_on_the_gpu() {
         return;
     }
     soak("gpu");
+}
+
+/// `scene` from config/ with its duration set to 0.3 s, in `dir` with the files it names.
+fn short_scene(dir: &std::path::Path, scene: &str, duration: &str) -> std::path::PathBuf {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
+    let text = std::fs::read_to_string(root.join(scene)).unwrap();
+    let key = format!("duration: {duration},");
+    assert!(text.contains(&key), "{scene} has {key}");
+    let path = dir.join(scene);
+    std::fs::write(&path, text.replace(&key, "duration: 0.3,")).unwrap();
+    std::fs::copy(root.join("rheology.ron"), dir.join("rheology.ron")).unwrap();
+    path
+}
+
+/// Soak `scene` three cuts on the CPU; soak.json's method, verdict and cycles.
+fn soak_short(scene: &std::path::Path, method: &str) -> Vec<serde_json::Value> {
+    let out = scene.with_extension("out");
+    let o = incise(&[
+        "soak",
+        scene.to_str().unwrap(),
+        "--seconds",
+        "0",
+        "--device",
+        "cpu",
+        "--out",
+        out.to_str().unwrap(),
+        "--markdown",
+    ]);
+    let report = std::fs::read_to_string(out.join("soak.json")).unwrap_or_default();
+    assert!(o.status.success(), "{}\n{report}", text(&o.stderr));
+    let r: serde_json::Value = serde_json::from_str(&report).expect("soak.json");
+    assert_eq!(
+        (r["method"].as_str(), &r["passed"]),
+        (Some(method), &true.into())
+    );
+    let cycles = r["cycles"].as_array().unwrap().clone();
+    assert_eq!(cycles.len(), 3, "{report}");
+    // Every cut has the first cut's result and fingerprint, and says so.
+    let first = &cycles[0];
+    assert!(
+        cycles.iter().all(|c| c["result"] == first["result"]
+            && c["fingerprint"] == first["fingerprint"]
+            && c["frames"] == first["frames"]
+            && c["matches_first"] == true
+            && c.get("released").is_none()),
+        "{report}"
+    );
+    let row = format!("| {} every cut |", first["result"].as_str().unwrap());
+    assert!(text(&o.stdout).contains(&row), "{}", text(&o.stdout));
+    cycles
+}
+
+#[test]
+fn the_nakao_plate_and_the_layered_organ_soak_by_their_own_results() {
+    let dir = temp_dir("soak-methods");
+    let nakao = soak_short(&short_scene(&dir, "plate_cut_nakao.ron", "1.6"), "nakao");
+    // The blade cut: the plate (1,250 nodes uncut) has more nodes after each cut.
+    let summary = nakao[0]["result"].as_str().unwrap();
+    let nodes: usize = summary.split(' ').next().unwrap().parse().unwrap();
+    assert!(nodes > 1_250, "{summary}");
+    let rheology = soak_short(&short_scene(&dir, "organ_layers.ron", "3.1"), "rheology");
+    // The indenter pressed: the probe node is dented by the end of each run.
+    let summary = rheology[0]["result"].as_str().unwrap();
+    let dent: f64 = summary.split(' ').nth(1).unwrap().parse().unwrap();
+    assert!(dent > 1.0, "{summary}");
 }

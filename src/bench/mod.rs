@@ -4,6 +4,7 @@
 
 pub mod realtime;
 pub mod render;
+pub mod scene;
 pub mod soak;
 
 use std::time::Instant;

@@ -42,6 +42,7 @@ fn open_options(opts: &RunOptions) -> OpenOptions {
         stroke: opts.stroke.clone(),
         haptic_rate: opts.haptic_rate,
         quiet: opts.quiet,
+        gpu: None,
     }
 }
 

@@ -7,7 +7,7 @@ use incise_sim::grab::Grab;
 use incise_sim::skin::Skin;
 use incise_sim::{Material, MeshBuildReport, RawMesh, Solver, TetMesh, TriSurface, generate, io};
 
-use super::{Generator, MaterialChoice, MeshSource, Scene, SkinSource, load_materials};
+use super::{Generator, MeshSource, Scene, SkinSource};
 
 /// A scene with its mesh built and its solver set up.
 pub struct BuiltScene {
@@ -72,7 +72,7 @@ pub fn build_scene_driven(
     };
     if let Some(model) = model {
         return Err(anyhow!(
-            "{}: model {model} runs in `incise run`, `preview`, `xr` and `render`; this command needs an Xpbd scene",
+            "{}: model {model} runs in `incise run`, `preview`, `xr`, `render`, `soak` and `bench scene`; this command needs an Xpbd scene",
             scene_path.display()
         ));
     }
@@ -91,25 +91,7 @@ pub fn build_scene_driven(
             Skin::embed(&mesh, s)
         }
     };
-    let (material, material_name) = match &scene.material {
-        MaterialChoice::Unset => {
-            return Err(anyhow!("{}: material is missing", scene_path.display()));
-        }
-        MaterialChoice::Custom(m) => (*m, "custom".to_string()),
-        MaterialChoice::Preset(name) => {
-            let file = dir.join("materials.ron");
-            let presets = load_materials(&file)?;
-            let m = presets.get(name).ok_or_else(|| {
-                anyhow!(
-                    "{}: material preset \"{name}\" is not in {} (known: {})",
-                    scene_path.display(),
-                    file.display(),
-                    presets.keys().cloned().collect::<Vec<_>>().join(", ")
-                )
-            })?;
-            (*m, name.clone())
-        }
-    };
+    let (material, material_name) = super::scene_material(scene, scene_path)?;
     let mut params = scene.solver.clone();
     params.release_threshold = scene.cutting.as_ref().map(|c| c.von_mises_threshold);
     if let Some(t) = threads {

@@ -5,6 +5,7 @@ mod build;
 pub mod hand_tool;
 mod load;
 mod localisation;
+mod material;
 mod model;
 mod tool;
 
@@ -12,6 +13,7 @@ pub use build::raw_mesh;
 pub use build::{BuiltScene, SceneTool, ToolDriver, build_scene, build_scene_driven};
 pub use load::{SceneError, load_materials, load_scene, locate, parse_scene};
 pub use localisation::Localisation;
+pub use material::scene_material;
 pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
     StrokeSpec,

@@ -6,6 +6,7 @@
 use std::path::Path;
 
 pub use super::method::Method;
+use super::outcome::Outcome;
 use crate::exercise::PlanDecal;
 use crate::pictures::run_pictures::RunPictures;
 use crate::pictures::screenshots::ImageSize;
@@ -97,6 +98,9 @@ pub struct OpenOptions {
     pub threads: Option<usize>,
     /// Where the XPBD solver runs.
     pub device: crate::sim_body::xpbd_device::DeviceChoice,
+    /// An open GPU context to put an XPBD solver on when `device` asks for the GPU (a
+    /// soak keeps one across its resets); `None`: one is opened for the body.
+    pub gpu: Option<incise_sim::gpu::GpuContext>,
     /// Drive the scene's tool with this stroke file instead of the scene's stroke (XPBD).
     pub stroke: Option<std::path::PathBuf>,
     /// Run a Nakao scene's local loop on its own thread at this rate, Hz (PHYSICS.md §2.6).
@@ -149,6 +153,10 @@ pub trait SimBody {
     /// After [`StepError::DeviceLost`]: the body on the CPU from its last completed frame
     /// (a body that runs on the CPU already stays as it is).
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody>;
+
+    /// The body's result now, in its method's terms, for checking that a replay or a
+    /// rollback reproduces it bit for bit (`None`: a haptic thread holds the state).
+    fn outcome(&self) -> Option<Outcome>;
 
     /// Inject `fault` (testing aid); an error when the method has no such fault.
     fn inject(&mut self, fault: Fault) -> anyhow::Result<()>;

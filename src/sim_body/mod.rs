@@ -2,14 +2,17 @@
 //! on its device, the Nakao mass-spring cutter (frame by frame or at a haptic rate) and
 //! the three-element rheological body, side by side; [`open`] opens a scene's.
 
+pub mod edge_report;
 pub mod interface;
 pub mod method;
 pub mod nakao;
 pub mod nakao_blade;
 pub mod nakao_haptic;
 pub mod nakao_open;
+pub mod nakao_outcome;
 pub mod nakao_surface;
 pub mod open;
+pub mod outcome;
 pub mod rheology;
 pub mod rheology_open;
 pub mod vertex_field;
@@ -21,4 +24,5 @@ pub use interface::{
 };
 pub use method::Method;
 pub use open::open;
+pub use outcome::Outcome;
 pub use xpbd_device::{Body, DeviceChoice, auto_device};

@@ -10,18 +10,21 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Result, bail};
-use glam::{DVec3, Quat, Vec3};
+use glam::{DVec3, Vec3};
 use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::mass_spring::{
-    HapticConfig, LocalLoop, LocalLoopParams, MassSpringModel, SystemClock, ToolCoupling,
+    DynamicState, HapticConfig, LocalLoop, LocalLoopParams, MassSpringModel, SystemClock,
+    ToolCoupling,
 };
 use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, opening_width};
 use incise_sim::nakao_cut::{BladePose, Cutter};
 
 use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
 use super::nakao_blade::Blade;
+use super::nakao_outcome::model_outcome;
 use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};
+use super::outcome::Outcome;
 use crate::report::localisation::{LocalisationInfo, LoopSample, LoopSplit};
 use crate::report::{EdgeFrameStats, FrameData, NakaoInfo, Report};
 use crate::scene::{Localisation, MassSpringScene};
@@ -35,8 +38,13 @@ const TENSION: Quantity = Quantity {
 /// A Nakao body stepped frame by frame, with its blade and localisation.
 pub struct NakaoBody {
     model: MassSpringModel,
-    /// The model after the last completed frame (what a failed frame rolls back to).
+    /// The model after the last frame whose cut remodelled it: the topology of the last
+    /// completed frame (a failed frame that remodelled rolls back to it).
     last_good: MassSpringModel,
+    /// Positions, velocities and time after the last completed frame (what every failed
+    /// frame rolls back to): saved every frame, while the whole model is copied only
+    /// when a cut changed it.
+    last_state: DynamicState,
     cutter: Cutter,
     cutting: bool,
     blade: Blade,
@@ -62,8 +70,11 @@ impl NakaoBody {
         let total_volume = (0..model.tet_count())
             .map(|t| model.reference_volume(t))
             .sum();
+        let mut last_state = DynamicState::default();
+        model.save_state(&mut last_state);
         NakaoBody {
             last_good: model.clone(),
+            last_state,
             model,
             cutter: Cutter::new(ms.cut.clone()),
             cutting: false,
@@ -89,11 +100,12 @@ impl NakaoBody {
         &self.model
     }
 
-    /// Move the blade as `tool` says and cut where it is engaged; the cut's ms.
+    /// Move the blade as `tool` says and cut where it is engaged; the cut's ms and
+    /// whether it remodelled the model.
     // PHYSICS.md §2.3–2.4: the cutter remodels and subdivides along the blade's sweep.
-    fn cut(&mut self, tool: &ToolInput) -> f64 {
+    fn cut(&mut self, tool: &ToolInput) -> (f64, bool) {
         let Some((pose, engaged, begin)) = self.blade.at(tool, self.model.time(), self.pose) else {
-            return 0.0;
+            return (0.0, false);
         };
         self.pose = Some(pose);
         if engaged && !self.cutting {
@@ -101,14 +113,14 @@ impl NakaoBody {
             self.cutting = true;
         }
         if !self.cutting {
-            return 0.0;
+            return (0.0, false);
         }
-        let ms = self.cutter.advance(&mut self.model, pose).ms;
+        let report = self.cutter.advance(&mut self.model, pose);
         if !engaged {
             self.cutter.end();
             self.cutting = false;
         }
-        ms
+        (report.ms, report.remodelled)
     }
 
     /// The frame's `steps` explicit steps of `dt`, localised around the blade when the
@@ -178,13 +190,29 @@ impl NakaoBody {
         self.coupling.pull(&mut self.model, &nodes, tip)
     }
 
-    /// Go back to the last completed frame, the blade lifted.
-    fn roll_back(&mut self) {
-        self.model = self.last_good.clone();
+    /// Go back to the last completed frame, the blade lifted: its topology too when this
+    /// frame's cut `remodelled` the model. An error when the saved state does not fit
+    /// (a remodelling frame that did not say so).
+    fn roll_back(&mut self, remodelled: bool) -> Result<(), String> {
+        if remodelled {
+            self.model.clone_from(&self.last_good);
+        }
         if self.cutting {
             self.cutter.end();
             self.cutting = false;
         }
+        self.model
+            .restore_state(&self.last_state)
+            .map_err(|e| e.to_string())
+    }
+
+    /// Keep the frame just completed for a rollback: its state, and the whole model when
+    /// its cut `remodelled` it.
+    fn keep(&mut self, remodelled: bool) {
+        if remodelled {
+            self.last_good.clone_from(&self.model);
+        }
+        self.model.save_state(&mut self.last_state);
     }
 }
 
@@ -203,16 +231,18 @@ impl SimBody for NakaoBody {
 
     fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError> {
         let t0 = Instant::now();
-        let cut_ms = self.cut(tool);
+        let (cut_ms, remodelled) = self.cut(tool);
         self.force = matches!(tool, ToolInput::Hand { .. }).then(|| self.couple());
         let steps = (self.frame_dt / self.model.stable_dt()).ceil().max(1.0) as u32;
         let sample = self.integrate(self.frame_dt / steps as f64, steps, cut_ms);
         self.model.clear_external_forces();
         if let Some(i) = self.model.positions().iter().position(|p| !p.is_finite()) {
-            self.roll_back();
+            let back = match self.roll_back(remodelled) {
+                Ok(()) => "rolled back to the last completed frame".to_string(),
+                Err(e) => format!("the rollback failed: {e}"),
+            };
             return Err(StepError::Failed(format!(
-                "frame {}: node {i} has a non-finite position; rolled back to the last \
-                 completed frame",
+                "frame {}: node {i} has a non-finite position; {back}",
                 self.frame
             )));
         }
@@ -220,15 +250,12 @@ impl SimBody for NakaoBody {
         self.samples.push(sample);
         let stats = self.stats(steps, wall_ms, &sample);
         self.frame += 1;
-        self.last_good.clone_from(&self.model);
+        self.keep(remodelled);
         Ok(FrameData::Edges(stats))
     }
 
     fn tool_pose(&self) -> Option<ToolPose> {
-        self.pose.map(|p| ToolPose {
-            position: p.tip.as_vec3(),
-            rotation: Quat::IDENTITY,
-        })
+        super::nakao_blade::tool_pose(self.pose)
     }
 
     fn tool_force(&self) -> Option<Vec3> {
@@ -264,6 +291,10 @@ impl SimBody for NakaoBody {
 
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody> {
         self
+    }
+
+    fn outcome(&self) -> Option<Outcome> {
+        Some(model_outcome(&self.model))
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {

@@ -3,7 +3,8 @@
 //! hand's tool pose (the tip at the tool's origin, the edge hanging below it, turned with
 //! the tool).
 
-use glam::{DQuat, DVec3};
+use glam::{DQuat, DVec3, Quat};
+use incise_sim::contact::ToolPose;
 use incise_sim::nakao_cut::BladePose;
 
 use super::interface::ToolInput;
@@ -56,6 +57,14 @@ impl Blade {
     }
 }
 
+/// The tool pose that shows blade `pose`: at its tip, unturned (`None`: no blade yet).
+pub fn tool_pose(pose: Option<BladePose>) -> Option<ToolPose> {
+    pose.map(|p| ToolPose {
+        position: p.tip.as_vec3(),
+        rotation: Quat::IDENTITY,
+    })
+}
+
 /// The blade pose at time `t` along stroke `s` and the stroke's progress (0 before it
 /// starts, 1 at its end).
 pub fn blade_at(s: &StrokeSpec, t: f64) -> (BladePose, f64) {
@@ -78,8 +87,7 @@ pub fn blade_at(s: &StrokeSpec, t: f64) -> (BladePose, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{Quat, Vec3};
-    use incise_sim::contact::ToolPose;
+    use glam::Vec3;
 
     fn stroke() -> StrokeSpec {
         StrokeSpec {

@@ -9,13 +9,14 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow, bail};
-use glam::{DVec3, Quat, Vec3};
+use glam::{DVec3, Vec3};
 use incise_sim::contact::ToolPose;
 use incise_sim::mass_spring::{HapticConfig, HapticLoop, LocalLoopParams, MassSpringModel};
 use incise_sim::nakao_cut::BladePose;
 
 use super::interface::{Fault, Method, SimBody, StepError, Surface, TetView, ToolInput};
 use super::nakao_blade::Blade;
+use super::outcome::Outcome;
 use crate::report::{EdgeFrameStats, FrameData, HapticInfo, Report};
 use crate::scene::{Localisation, MassSpringScene, StrokeSpec};
 
@@ -150,10 +151,7 @@ impl SimBody for NakaoHapticBody {
     }
 
     fn tool_pose(&self) -> Option<ToolPose> {
-        self.pose.map(|p| ToolPose {
-            position: p.tip.as_vec3(),
-            rotation: Quat::IDENTITY,
-        })
+        super::nakao_blade::tool_pose(self.pose)
     }
 
     fn tool_force(&self) -> Option<Vec3> {
@@ -208,6 +206,13 @@ impl SimBody for NakaoHapticBody {
 
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody> {
         self
+    }
+
+    fn outcome(&self) -> Option<Outcome> {
+        match &self.holder {
+            Holder::Here(m) => Some(super::nakao_outcome::model_outcome(m)),
+            _ => None,
+        }
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {

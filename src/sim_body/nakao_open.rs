@@ -5,16 +5,17 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow, bail};
+use anyhow::{Context, Result, anyhow};
 use incise_sim::mass_spring::{AxisMask, MassSpringModel, MassSpringParams};
 use incise_sim::nakao_cut::measure::counts;
-use incise_sim::{Material, MeshBuildReport, TetMesh};
+use incise_sim::{MeshBuildReport, TetMesh};
 
+use super::edge_report::{HeadCounts, edge_method_head};
 use super::interface::{Method, OpenOptions, SimBody};
 use super::nakao::NakaoBody;
 use super::nakao_haptic::NakaoHapticBody;
-use crate::report::{MaterialInfo, MeshInfo, Report};
-use crate::scene::{MassSpringScene, MaterialChoice, Scene, load_materials, raw_mesh};
+use crate::report::{MaterialInfo, Report};
+use crate::scene::{MassSpringScene, Scene, raw_mesh, scene_material};
 
 /// Open the mass-spring scene `scene` (model settings `ms`, file `path`) as `opts` asks.
 pub fn open(
@@ -27,7 +28,7 @@ pub fn open(
     let (raw, _) = raw_mesh(&scene.mesh, dir)?;
     let (mesh, mesh_report) =
         TetMesh::from_raw(raw).with_context(|| format!("{}: mesh", path.display()))?;
-    let (material, material_name) = material(scene, dir, path)?;
+    let (material, material_name) = scene_material(scene, path)?;
     let params = MassSpringParams {
         stiffness: ms.stiffness,
         stiffness_law: ms.stiffness_law,
@@ -103,43 +104,18 @@ fn skeleton(
     mesh_report: &MeshBuildReport,
     pinned: usize,
 ) -> Report {
-    let mut report = Report::begin(
+    let counts = HeadCounts {
+        nodes: model.node_count(),
+        tets: model.tet_count(),
+        skin_vertices: model.node_count(),
+        skin_triangles: counts(model).triangles,
+        pinned,
+    };
+    edge_method_head(
         scene,
         path,
         ("mass-spring", Method::Nakao),
-        MeshInfo {
-            nodes: model.node_count(),
-            tets: model.tet_count(),
-            reoriented_tets: mesh_report.reoriented_tets,
-            colors: 0,
-            skin_vertices: model.node_count(),
-            skin_triangles: counts(model).triangles,
-            pinned_nodes: pinned,
-            grabbed_nodes: 0,
-            warnings: mesh_report.warnings.clone(),
-        },
-        scene.solver.clone(),
-    );
-    report.device = "cpu (mass-spring)".into();
-    report
-}
-
-/// The scene's material, resolving a preset from `materials.ron` beside the scene.
-fn material(scene: &Scene, dir: &Path, scene_path: &Path) -> Result<(Material, String)> {
-    Ok(match &scene.material {
-        MaterialChoice::Unset => bail!("{}: material is missing", scene_path.display()),
-        MaterialChoice::Custom(m) => (*m, "custom".to_string()),
-        MaterialChoice::Preset(name) => {
-            let file = dir.join("materials.ron");
-            let presets = load_materials(&file)?;
-            let m = presets.get(name).ok_or_else(|| {
-                anyhow!(
-                    "{}: material preset \"{name}\" is not in {}",
-                    scene_path.display(),
-                    file.display()
-                )
-            })?;
-            (*m, name.clone())
-        }
-    })
+        mesh_report,
+        counts,
+    )
 }

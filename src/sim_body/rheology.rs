@@ -13,9 +13,10 @@ use glam::{DVec2, DVec3, Quat, Vec3};
 use incise_sim::TetMesh;
 use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
-use incise_sim::rheology::{FlatIndenter, PressSchedule, RheologyBody as Model};
+use incise_sim::rheology::{FlatIndenter, PressSchedule, RheologyBody as Model, RheologyState};
 
 use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
+use super::outcome::{Outcome, StateHash};
 use crate::report::{EdgeFrameStats, FrameData, Report};
 use crate::scene::IndenterSpec;
 
@@ -97,8 +98,9 @@ impl Press {
 /// A rheological body with its mesh, press and dent figures.
 pub struct RheologyBody {
     model: Model,
-    /// The model after the last completed frame (what a failed frame rolls back to).
-    last_good: Model,
+    /// Positions, velocities, ratios and time after the last completed frame (what a
+    /// failed frame rolls back to; the rest of the model does not change).
+    last_good: RheologyState,
     mesh: TetMesh,
     press: Press,
     /// Whether the last frame's face came from a hand (which replaces it every frame).
@@ -116,8 +118,10 @@ impl RheologyBody {
     /// The body of `model` on `mesh`, pressed as `press` says, stepped every `frame_dt`.
     pub fn new(model: Model, mesh: TetMesh, press: Press, frame_dt: f64) -> RheologyBody {
         let rest_volume = mesh.rest_volume.iter().map(|&v| v as f64).sum();
+        let mut last_good = RheologyState::default();
+        model.save_state(&mut last_good);
         let mut body = RheologyBody {
-            last_good: model.clone(),
+            last_good,
             model,
             mesh,
             press,
@@ -214,10 +218,11 @@ impl SimBody for RheologyBody {
         let steps = match self.model.advance(self.frame_dt) {
             Ok(n) => n,
             Err(e) => {
-                self.model = self.last_good.clone();
-                return Err(StepError::Failed(format!(
-                    "{e} (rolled back to the last completed frame)"
-                )));
+                let back = match self.model.restore_state(&self.last_good) {
+                    Ok(()) => "rolled back to the last completed frame".to_string(),
+                    Err(r) => format!("the rollback failed: {r}"),
+                };
+                return Err(StepError::Failed(format!("{e} ({back})")));
             }
         };
         let solve_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -225,7 +230,7 @@ impl SimBody for RheologyBody {
         self.max_dent = self.max_dent.max(self.dent);
         let stats = self.stats(steps, solve_ms);
         self.frame += 1;
-        self.last_good.clone_from(&self.model);
+        self.model.save_state(&mut self.last_good);
         Ok(FrameData::Edges(stats))
     }
 
@@ -303,6 +308,20 @@ impl SimBody for RheologyBody {
 
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody> {
         self
+    }
+
+    fn outcome(&self) -> Option<Outcome> {
+        let n = self.model.node_count();
+        let mut h = StateHash::new();
+        h.reals([self.model.time()])
+            .vectors(&self.model.positions())
+            .vectors(&(0..n).map(|i| self.model.velocity(i)).collect::<Vec<_>>())
+            .reals(self.model.ratios().iter().copied());
+        Some(Outcome {
+            summary: format!("dent {:.4} mm", self.dent() * 1e3),
+            hash: h.finish(),
+            released: None,
+        })
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {

@@ -10,9 +10,10 @@ use incise_sim::rheology::{
 };
 use incise_sim::{MeshBuildReport, TetMesh};
 
+use super::edge_report::{HeadCounts, edge_method_head};
 use super::interface::{Method, OpenOptions};
 use super::rheology::{Press, RheologyBody};
-use crate::report::{MeshInfo, RegionMaterialInfo, Report, RheologyInfo};
+use crate::report::{RegionMaterialInfo, Report, RheologyInfo};
 use crate::scene::{RegionSelect, RheologyScene, Scene, SceneError, locate, raw_mesh};
 
 /// Open the rheology scene `scene` (model settings `rh`, file `path`).
@@ -90,25 +91,20 @@ fn skeleton(
     mesh_report: &MeshBuildReport,
     pinned: usize,
 ) -> Report {
-    let mut report = Report::begin(
+    let counts = HeadCounts {
+        nodes: mesh.node_count(),
+        tets: mesh.tet_count(),
+        skin_vertices: 0,
+        skin_triangles: 0,
+        pinned,
+    };
+    edge_method_head(
         scene,
         path,
         ("rheology", Method::Rheology),
-        MeshInfo {
-            nodes: mesh.node_count(),
-            tets: mesh.tet_count(),
-            reoriented_tets: mesh_report.reoriented_tets,
-            colors: 0,
-            skin_vertices: 0,
-            skin_triangles: 0,
-            pinned_nodes: pinned,
-            grabbed_nodes: 0,
-            warnings: mesh_report.warnings.clone(),
-        },
-        scene.solver.clone(),
-    );
-    report.device = "cpu (rheology)".into();
-    report
+        mesh_report,
+        counts,
+    )
 }
 
 /// The material list: the default first, then one per region (duplicates are harmless).

@@ -15,6 +15,7 @@ use incise_sim::xpbd::SolverError;
 use super::interface::{
     Fault, Method, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
 };
+use super::outcome::{Outcome, StateHash};
 use super::vertex_field::vertex_mean;
 use super::xpbd_device::Body;
 use crate::exercise::PlanDecal;
@@ -75,7 +76,9 @@ pub fn open(
     let mut report = skeleton(scene, path, &built, tool.as_ref());
     let mut choice = None;
     let BuiltScene { solver, skin, .. } = built;
-    let body = Body::place(solver, opts.device, |m| choice = Some(m.to_string()))?;
+    let body = Body::place_on(solver, opts.device, opts.gpu.as_ref(), |m| {
+        choice = Some(m.to_string())
+    })?;
     if let Some(m) = choice.as_ref().filter(|_| !opts.quiet) {
         eprintln!("note: {m}");
     }
@@ -267,6 +270,17 @@ impl SimBody for XpbdBody {
         })
     }
 
+    fn outcome(&self) -> Option<Outcome> {
+        let released = released_tets(self.body.solver());
+        Some(Outcome {
+            summary: format!("{} tets released", released.len()),
+            hash: StateHash::new()
+                .ints(released.iter().map(|&t| u64::from(t)))
+                .finish(),
+            released: Some(released.len()),
+        })
+    }
+
     fn inject(&mut self, fault: Fault) -> Result<()> {
         match fault {
             Fault::Nan => self.body.inject_nan(),
@@ -276,10 +290,7 @@ impl SimBody for XpbdBody {
     }
 
     fn finish(&mut self, report: &mut Report) -> Result<Option<String>> {
-        let cut = self.body.solver().cut();
-        report.released_tets = (0..self.body.solver().mesh().tet_count() as u32)
-            .filter(|&t| !cut.is_live(t as usize))
-            .collect();
+        report.released_tets = released_tets(self.body.solver());
         Ok(None)
     }
 
@@ -307,6 +318,14 @@ impl SimBody for XpbdBody {
             RunPictures::Views(v) => v.save(self.tet_view(), path),
         }
     }
+}
+
+/// The tets `solver` has released, in index order.
+pub fn released_tets(solver: &Solver) -> Vec<u32> {
+    let cut = solver.cut();
+    (0..solver.mesh().tet_count() as u32)
+        .filter(|&t| !cut.is_live(t as usize))
+        .collect()
 }
 
 /// Write `solver`'s state as a `.vtu` at `path`: per tet von Mises stress and released,

@@ -22,7 +22,7 @@ pub enum DeviceChoice {
 /// A compute context on the best adapter, opened as the renderer's headless device is
 /// (primary backends first, so a machine without a display prints no window-system
 /// errors), with the limits the GPU solver needs.
-fn gpu_context() -> Result<GpuContext> {
+pub fn gpu_context() -> Result<GpuContext> {
     Ok(incise_xr::RenderDevice::headless()
         .context("opening the GPU solver's device")?
         .compute_context())
@@ -66,13 +66,28 @@ impl Body {
     /// Put `solver` (pins and grabs applied) on the chosen device. `notice` receives the
     /// line explaining an automatic fall-back to the CPU.
     pub fn place(solver: Solver, choice: DeviceChoice, notice: impl FnOnce(&str)) -> Result<Body> {
+        Body::place_on(solver, choice, None, notice)
+    }
+
+    /// [`Body::place`] on the open context `gpu` when the choice is the GPU (`None`: a
+    /// context is opened for this body).
+    pub fn place_on(
+        solver: Solver,
+        choice: DeviceChoice,
+        gpu: Option<&GpuContext>,
+        notice: impl FnOnce(&str),
+    ) -> Result<Body> {
+        let context = || match gpu {
+            Some(ctx) => Ok(ctx.clone()),
+            None => gpu_context(),
+        };
         match choice {
             DeviceChoice::Cpu => Ok(Body::Cpu(Box::new(solver))),
             DeviceChoice::Gpu => {
-                let ctx = gpu_context()?;
+                let ctx = context()?;
                 Ok(Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?)))
             }
-            DeviceChoice::Auto => match gpu_context() {
+            DeviceChoice::Auto => match context() {
                 Ok(ctx) => {
                     let (pick, why) = auto_device(&ctx.info);
                     notice(&why);

@@ -62,6 +62,14 @@ pub enum MassSpringError {
         /// Node count.
         count: usize,
     },
+    /// A saved dynamic state does not fit the model (a cut added nodes since it was saved).
+    #[error("the saved state has {saved} nodes but the model has {nodes}")]
+    StateMismatch {
+        /// Nodes of the saved state.
+        saved: usize,
+        /// Nodes of the model.
+        nodes: usize,
+    },
     /// The mesh has a tet of non-positive volume.
     #[error("tet {tet} has non-positive volume {volume:e} m^3")]
     BadTet {

@@ -124,6 +124,10 @@ pub struct CutReport {
     pub worst_dihedral_deg: f64,
     /// Wall time of the advance, ms.
     pub ms: f64,
+    /// Whether the advance changed the model beyond its positions, velocities and time
+    /// (nodes, tets, cut faces, springs, masses or reference positions, also by moves it
+    /// undid): a caller that keeps a copy of the model for a rollback must renew it.
+    pub remodelled: bool,
 }
 
 /// The cutting tool: follows the blade from pose to pose and cuts the model.
@@ -240,6 +244,8 @@ impl Cutter {
         // adaptive moves must respect.
         let baseline = plan_split(model, &cross.split, false);
         let mut moved: Vec<Moved> = Vec::new();
+        // Moves undone below still leave their rounding in the reference positions.
+        let mut undone = false;
         let plan = if p.subdivision == Subdivision::Adaptive && !cross.split.is_empty() {
             let floor = baseline.quality.min_deg;
             let snapper = Snapper {
@@ -265,6 +271,7 @@ impl Cutter {
             if plan.quality.merge(reshaped).min_deg < floor - 1e-9 {
                 // The moves did not pay off: undo them and split as the baseline would,
                 // in the best order.
+                undone = !moved.is_empty();
                 for m in moved.drain(..).rev() {
                     model.displace(m.node as usize, -m.by);
                     on_cut.remove(&m.node);
@@ -367,6 +374,11 @@ impl Cutter {
             smoothed_nodes: smoothed.len(),
             worst_dihedral_deg: tets_quality(model, &judged).min_deg,
             ms: 0.0,
+            remodelled: undone
+                || !affected.is_empty()
+                || separation.flagged_faces > 0
+                || model.node_count() != nodes_before
+                || model.tet_count() != tets_before,
         }
     }
 }

@@ -14,6 +14,9 @@ pub(crate) struct Separation {
     pub duplicated: Vec<[u32; 2]>,
     /// Interior faces opened (each now two boundary faces).
     pub opened_faces: usize,
+    /// Tet faces newly flagged as cut surface (a face opened by an earlier advance is
+    /// counted in `opened_faces` again, not here).
+    pub flagged_faces: usize,
     /// Tets whose nodes were renumbered.
     pub touched_tets: Vec<u32>,
 }
@@ -51,7 +54,9 @@ pub(crate) fn separate(
     cut_nodes.sort_unstable();
     cut_nodes.dedup();
     for &(t, f) in &marked {
-        model.tet_cut_faces[t as usize] |= 1 << f;
+        let flags = model.tet_cut_faces[t as usize];
+        model.tet_cut_faces[t as usize] = flags | 1 << f;
+        out.flagged_faces += usize::from(flags & 1 << f == 0);
     }
     for v in cut_nodes {
         let components = star_components(model, v, &marked);

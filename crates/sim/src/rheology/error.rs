@@ -28,6 +28,14 @@ pub enum RheologyError {
         /// The stability limit, s.
         limit: f64,
     },
+    /// A saved state does not fit the body (saved from another body).
+    #[error("the saved state has {saved} values but the body has {values}")]
+    StateMismatch {
+        /// Values of the saved state.
+        saved: usize,
+        /// Values of the body's state.
+        values: usize,
+    },
     /// The state became NaN or infinite.
     #[error("the simulation diverged (non-finite state) at t = {time} s")]
     Diverged {

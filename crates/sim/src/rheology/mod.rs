@@ -24,6 +24,7 @@ mod sag;
 mod single;
 mod specimen;
 mod stability;
+mod state;
 
 pub use body::RheologyBody;
 pub use closed_form::creep_recovery;
@@ -40,3 +41,4 @@ pub use sag::sag_under_gravity;
 pub use single::{CreepSample, CreepTest};
 pub use specimen::{Specimen, SpecimenMesh};
 pub use stability::{RK4_HALF_DISK_RADIUS, SAFETY, StabilityLimit, stability_limit};
+pub use state::RheologyState;
