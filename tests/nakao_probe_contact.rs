@@ -99,9 +99,11 @@ fn frame_rate_body_couples_the_probe_as_the_scene_says() {
     check(&god, &nearest, "frame rate");
 }
 
+/// Each height is held six 10 ms frames, so that the thread has looped at the new pose
+/// (some 50 loops) on a loaded machine before the force is read.
 #[test]
 fn haptic_thread_couples_the_probe_as_the_scene_says() {
-    let god = press("GodObject", &PATH_MM, 3, Some(1000.0));
-    let nearest = press("NearestNode", &PATH_MM, 3, Some(1000.0));
+    let god = press("GodObject", &PATH_MM, 6, Some(1000.0));
+    let nearest = press("NearestNode", &PATH_MM, 6, Some(1000.0));
     check(&god, &nearest, "haptic thread");
 }
