@@ -239,6 +239,56 @@ fn nakao_headset_cuts_by_its_stroke_and_by_the_controller_with_its_own_force() {
     assert!(pulses > 10.0, "{stdout}");
 }
 
+/// `incise xr` on the Nakao plate with a real-time simulated headset and every body
+/// frame slowed by 40 ms (4× its 10 ms): `--sim`'s `mode`; the summary line.
+fn slowed_realtime_headset(dir: &Path, mode: &str) -> Option<String> {
+    let script = dir.join(format!("realtime-{mode}.ron"));
+    let written = std::fs::read_to_string(self::script(dir, 0.8, "realtime: true,")).unwrap();
+    std::fs::write(&script, written).unwrap();
+    let out = dir.join(mode);
+    let o = incise(&[
+        "xr",
+        "config/plate_cut_nakao.ron",
+        "--simulated-headset",
+        script.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--sim",
+        mode,
+        "--slow-sim-ms",
+        "40",
+    ]);
+    if no_adapter(&o) {
+        return None;
+    }
+    assert!(o.status.success(), "--sim {mode}: {}", text(&o.stderr));
+    let r = report(&out);
+    assert_eq!(r["method"], "nakao", "--sim {mode}: {r}");
+    assert!(r["frames"].as_array().unwrap().len() >= 3, "--sim {mode}");
+    Some(text(&o.stdout))
+}
+
+/// A Nakao body on its own thread costs a real-time headset no wait: with every body
+/// frame slowed to 50 ms, a display frame stepped in the frame takes as long as the
+/// frames it steps, while with the body on its thread it only draws the newest one.
+#[test]
+fn a_slow_nakao_body_on_its_thread_costs_the_headset_no_wait() {
+    let dir = temp_dir("mh-nakao-thread");
+    let Some(in_frame) = slowed_realtime_headset(&dir, "in-frame") else {
+        return;
+    };
+    let thread = slowed_realtime_headset(&dir, "thread").unwrap();
+    assert!(thread.contains("body stepped thread"), "{thread}");
+    assert!(in_frame.contains("body stepped in-frame"), "{in_frame}");
+    let (waits, free) = (
+        number_after(&in_frame, "display frame work p50 "),
+        number_after(&thread, "display frame work p50 "),
+    );
+    eprintln!("display frame work p50: in the frame {waits} ms, on a thread {free} ms");
+    assert!(waits >= 40.0, "in the frame: {in_frame}");
+    assert!(free < 20.0 && free * 2.0 < waits, "on a thread: {thread}");
+}
+
 #[test]
 fn rheology_headset_presses_and_creeps_back() {
     let dir = temp_dir("mh-rheology");

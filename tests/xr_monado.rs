@@ -406,3 +406,45 @@ fn the_gpu_solver_on_its_thread_costs_monado_no_display_frame() {
         "the display waited for the GPU solver: {r}"
     );
 }
+
+/// Issue 20: a Nakao scene on the real runtime. Its body runs on its own thread (the
+/// default for a real-time headset), the session renders into Monado's swapchains, ends
+/// after `--frames` through EXITING, and the body's report (the run's schema) is written;
+/// with a body slowed to 100 ms a frame, the display's own work per frame stays small.
+#[test]
+fn a_nakao_scene_on_monado_steps_its_body_on_a_thread() {
+    let Some(manifest) = monado::monado() else {
+        return;
+    };
+    let layers = monado::validation();
+    let dir = temp_dir("xr-monado-nakao");
+    let out = dir.join("out");
+    let args = [
+        "xr",
+        "config/plate_cut_nakao.ron",
+        "--frames",
+        "30",
+        "--slow-sim-ms",
+        "100",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let o = monado::run(manifest, &dir, &args, layers);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    assert_validation_clean(&o, &dir, layers);
+    let stdout = text(&o.stdout);
+    assert!(stdout.contains("on Monado"), "{stdout}");
+    assert!(stdout.contains("body stepped thread"), "{stdout}");
+    assert!(stdout.contains("30 display frames"), "{stdout}");
+    let work: f64 = stdout
+        .split("display frame work p50 ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no frame work in {stdout}"));
+    assert!(work < 50.0, "the display waited for the body: {stdout}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["method"], "nakao", "{report}");
+    assert!(!report["frames"].as_array().unwrap().is_empty(), "{report}");
+}

@@ -42,8 +42,8 @@ pub fn run(w: MethodWindow) -> Result<()> {
     let Some(live) = run_window(w.size, |shell| Live::open(shell, w))? else {
         return Ok(());
     };
-    let lines = live.body.live_lines();
-    println!("{}", live.body.close(None)?);
+    let lines = live.body.sim.live_lines();
+    println!("{}", live.body.sim.close(None)?);
     for line in lines {
         println!("last frame's {line}");
     }
@@ -179,7 +179,7 @@ impl Live {
         if !self.hand {
             return ToolInput::Script;
         }
-        let pose = self.scalpel.advance(self.body.body.frame_dt() as f32);
+        let pose = self.scalpel.advance(self.body.sim.body.frame_dt() as f32);
         ToolInput::Hand {
             pose,
             engaged: self.scalpel.cutting(),
@@ -189,8 +189,8 @@ impl Live {
     /// The side panel: scene, method, heat-map quantity, localisation, frame, play/pause.
     fn panel(&mut self) -> (super::window_gpu::PanelFrame, f32) {
         let body = &self.body;
-        let (method, quantity) = (body.body.method().name(), body.quantity());
-        let live_lines = body.live_lines();
+        let (method, quantity) = (body.sim.body.method().name(), body.quantity());
+        let live_lines = body.sim.live_lines();
         let (mut width, mut playing) = (0.0, self.playing);
         let message = &self.message;
         let frame = self.shell.panel(|ui| {
@@ -200,8 +200,8 @@ impl Live {
                     ui.heading(format!("{method} body"));
                     ui.label(format!(
                         "frame {}, t = {:.2} s",
-                        body.frames(),
-                        body.body.time()
+                        body.sim.frames(),
+                        body.sim.body.time()
                     ));
                     if let Some(q) = quantity {
                         ui.label(format!(

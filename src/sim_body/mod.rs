@@ -13,6 +13,7 @@ pub mod nakao_outcome;
 pub mod nakao_surface;
 pub mod open;
 pub mod outcome;
+pub mod recorded;
 pub mod rheology;
 pub mod rheology_open;
 pub mod vertex_field;

@@ -8,6 +8,7 @@ pub mod frame_loop;
 pub mod in_frame;
 pub mod latest;
 pub mod method_session;
+pub mod method_thread;
 pub mod script;
 pub mod sim_mode;
 pub mod sim_source;
@@ -159,19 +160,16 @@ pub fn run(opts: &XrOptions) -> Result<String> {
 
 /// `incise xr` for a Nakao or rheology scene, on the simulated headset or the runtime's.
 fn run_method(opts: &XrOptions) -> Result<String> {
+    let sim = method_session::MethodSim {
+        choice: opts.sim,
+        slow: Duration::from_millis(opts.slow_sim_ms),
+        frames: opts.frames,
+    };
     if let Some(script) = &opts.simulated {
-        return method_session::run_simulated(&opts.scene, script, &opts.out);
+        return method_session::run_simulated(&opts.scene, script, &opts.out, &sim);
     }
     let mut session = open_session(&opts.scene)?;
-    let body = crate::pictures::drawn_body::DrawnBody::open(&opts.scene)?;
-    let (lo, hi) = body.drawing.render.mesh.rest_bounds();
-    method_session::run_on(
-        &mut session,
-        &opts.scene,
-        body,
-        Tray::for_bounds(lo, hi),
-        &opts.out,
-    )
+    method_session::run_on_runtime(&mut session, &opts.scene, &opts.out, &sim)
 }
 
 /// The OpenXR session, or [`XrUnavailable`] naming what is missing.
