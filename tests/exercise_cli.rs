@@ -358,6 +358,22 @@ fn malformed_exercises_are_errors_naming_the_field() {
     );
 }
 
+/// An exercise on a Nakao scene is refused at its `scene` line, saying why (scoring is
+/// defined on an XPBD body's released tets) and where the scene does open.
+#[test]
+fn an_exercise_on_a_nakao_scene_is_refused_naming_its_scene_line() {
+    let dir = temp_dir("exercise-nakao");
+    let nakao = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut_nakao.ron");
+    let to = format!("\"{}\"", nakao.display());
+    let path = bad_exercise(&dir, "nakao", "\"../slab_layer.ron\"", &to);
+    let o = incise(&["exercise", path.to_str().unwrap(), "--stroke", "unused.ron"]);
+    let err = text(&o.stderr);
+    assert!(!o.status.success(), "a Nakao exercise was accepted");
+    assert!(err.contains("nakao.ron:7: scene"), "{err}");
+    assert!(err.contains("is a MassSpring scene"), "{err}");
+    assert!(err.contains("incise preview"), "{err}");
+}
+
 #[test]
 fn shipped_exercises_all_load() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/exercises");

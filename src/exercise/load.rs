@@ -49,6 +49,18 @@ pub fn load_exercise(path: &Path) -> Result<LoadedExercise> {
         .into());
     }
     let scene = load_scene(&scene_path).with_context(|| format!("{}: scene", path.display()))?;
+    if let Some(model) = scene.model.non_xpbd_name() {
+        return Err(value_err(
+            "scene",
+            locate(&text, "scene"),
+            format!(
+                "{} is a {model} scene: exercises are scored on an XPBD body's released tets \
+                 (docs/scoring.md); open it with `incise preview`, `incise xr` or `incise run`",
+                scene_path.display()
+            ),
+        )
+        .into());
+    }
     if scene.tool.is_none() {
         return Err(value_err(
             "scene",

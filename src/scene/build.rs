@@ -65,12 +65,7 @@ pub fn build_scene_driven(
     threads: Option<usize>,
     driver: ToolDriver,
 ) -> Result<BuiltScene> {
-    let model = match &scene.model {
-        super::ModelChoice::Xpbd => None,
-        super::ModelChoice::MassSpring(_) => Some("MassSpring"),
-        super::ModelChoice::Rheology(_) => Some("Rheology"),
-    };
-    if let Some(model) = model {
+    if let Some(model) = scene.model.non_xpbd_name() {
         return Err(anyhow!(
             "{}: model {model} runs in `incise run`, `preview`, `xr`, `render`, `soak` and `bench scene`; this command needs an Xpbd scene",
             scene_path.display()

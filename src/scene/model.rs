@@ -25,6 +25,18 @@ pub enum ModelChoice {
     Rheology(RheologyScene),
 }
 
+impl ModelChoice {
+    /// The model's name in a scene file when it is not XPBD (`MassSpring`, `Rheology`);
+    /// `None` for XPBD.
+    pub fn non_xpbd_name(&self) -> Option<&'static str> {
+        match self {
+            ModelChoice::Xpbd => None,
+            ModelChoice::MassSpring(_) => Some("MassSpring"),
+            ModelChoice::Rheology(_) => Some("Rheology"),
+        }
+    }
+}
+
 /// Settings of a rheology scene: the materials per region and an optional flat indenter.
 ///
 /// Which tet and edge takes which material: every tet takes `material`, then each region
