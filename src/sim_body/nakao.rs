@@ -21,7 +21,7 @@ use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, op
 use incise_sim::nakao_cut::{BladePose, Cutter};
 
 use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
-use super::nakao_blade::Blade;
+use super::nakao_blade::{Blade, tool_point};
 use super::nakao_outcome::model_outcome;
 use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};
 use super::outcome::Outcome;
@@ -127,7 +127,7 @@ impl NakaoBody {
     /// scene asks for it; the localisation figures.
     // PHYSICS.md §2.1 (eq. 2) and §2.5 (localisation, refresh-rate manager).
     fn integrate(&mut self, dt: f64, steps: u32, cut_ms: f64) -> LoopSample {
-        let tip = self.pose.map(|p| (p.heel + p.tip) * 0.5);
+        let tip = self.pose.map(tool_point);
         if let (Some(l), Some(tip)) = (&mut self.local, tip) {
             let s = l.frame(&mut self.model, tip, dt, steps);
             return LoopSample {
@@ -183,7 +183,7 @@ impl NakaoBody {
         let Some(p) = self.pose else {
             return DVec3::ZERO;
         };
-        let tip = (p.heel + p.tip) * 0.5;
+        let tip = tool_point(p);
         let nodes = self
             .coupling
             .nodes(&self.model, tip, |m, q| m.nearest_node(q));

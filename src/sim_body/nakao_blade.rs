@@ -57,6 +57,12 @@ impl Blade {
     }
 }
 
+/// The blade's tool point, where the haptic coupling and the localisation act: the middle
+/// of its cutting edge.
+pub fn tool_point(pose: BladePose) -> DVec3 {
+    (pose.heel + pose.tip) * 0.5
+}
+
 /// The tool pose that shows blade `pose`: at its tip, unturned (`None`: no blade yet).
 pub fn tool_pose(pose: Option<BladePose>) -> Option<ToolPose> {
     pose.map(|p| ToolPose {

@@ -15,7 +15,7 @@ use incise_sim::mass_spring::{HapticConfig, HapticLoop, LocalLoopParams, MassSpr
 use incise_sim::nakao_cut::BladePose;
 
 use super::interface::{Fault, Method, SimBody, StepError, Surface, TetView, ToolInput};
-use super::nakao_blade::Blade;
+use super::nakao_blade::{Blade, tool_point};
 use super::outcome::Outcome;
 use crate::report::{EdgeFrameStats, FrameData, HapticInfo, Report};
 use crate::scene::{Localisation, MassSpringScene, StrokeSpec};
@@ -41,11 +41,6 @@ pub struct NakaoHapticBody {
     max_force: f64,
     last_force: DVec3,
     last_time: f64,
-}
-
-/// The tool point of the haptic loop: the middle of the blade's edge.
-fn tool_point(pose: BladePose) -> DVec3 {
-    (pose.heel + pose.tip) * 0.5
 }
 
 impl NakaoHapticBody {
