@@ -49,10 +49,8 @@ fn open_options(opts: &RunOptions) -> OpenOptions {
 /// Strokes drive and record the XPBD scalpel only: refused for the other methods, whose
 /// tools follow their own scripts.
 fn refuse_xpbd_only_options(model: &ModelChoice, opts: &RunOptions) -> Result<()> {
-    let method = match model {
-        ModelChoice::Xpbd => return Ok(()),
-        ModelChoice::MassSpring(_) => "MassSpring",
-        ModelChoice::Rheology(_) => "Rheology",
+    let Some(method) = model.non_xpbd_name() else {
+        return Ok(());
     };
     for (given, flag) in [
         (opts.stroke.is_some(), "--stroke"),
