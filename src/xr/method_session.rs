@@ -24,6 +24,7 @@ use super::script::{HeadsetScript, RightTrack};
 use super::sim_mode::{self, SimChoice, SimMode};
 use super::sim_thread::MAX_CATCH_UP;
 use super::simulated::SimulatedHeadset;
+use crate::bench::soak::percentile;
 use crate::pictures::tet_drawing::TetDrawing;
 use crate::sim_body::ToolInput;
 use crate::sim_body::recorded::RecordedBody;
@@ -181,10 +182,8 @@ fn run_on(
         }
     }
     let (frames, rendered, pulses) = (s.frames, s.rendered, s.pulses);
-    let (p50, p95) = (
-        quantile(&mut s.frame_ms, 0.5),
-        quantile(&mut s.frame_ms, 0.95),
-    );
+    s.frame_ms.sort_by(f64::total_cmp);
+    let (p50, p95) = (percentile(&s.frame_ms, 0.5), percentile(&s.frame_ms, 0.95));
     let summary = match s.stepper {
         Stepper::InFrame(body, _) => body.close(Some(&out.join("report.json")))?,
         Stepper::Thread(thread, _) => thread.finish()?,
@@ -196,14 +195,6 @@ fn run_on(
         headset.describe(),
         mode.name(),
     ))
-}
-
-/// The `q` quantile (nearest rank) of `v`, ms; 0 when empty.
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(((v.len().max(1) - 1) as f64 * q).round() as usize)
-        .copied()
-        .unwrap_or(0.0)
 }
 
 /// The next begun frame, `None` when the session has ended.
