@@ -258,8 +258,8 @@ fn render_view_frame(
     };
     let (mut body, _) = crate::sim_body::open(scene, scene_path, &opts)?;
     let mut pictures = super::view_pictures::ViewPictures::new(size, overlays)?;
-    // The first picture fixes the camera on the body at rest, as for an XPBD scene.
-    pictures.image(body.tet_view())?;
+    // The camera frames the body at rest, as for an XPBD scene.
+    pictures.aim(body.tet_view())?;
     for f in 0..frame {
         body.step(&crate::sim_body::ToolInput::Script)
             .with_context(|| format!("{}: frame {f}", scene_path.display()))?;

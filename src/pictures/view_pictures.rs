@@ -36,8 +36,9 @@ impl ViewPictures {
         })
     }
 
-    /// Draw `view` now.
-    pub fn image(&mut self, view: TetView) -> Result<RgbaImage> {
+    /// Take `view` as the body to draw: its drawing updated (the renderer rebuilt when its
+    /// topology changed), and the camera framing it if this is the first view.
+    pub fn aim(&mut self, view: TetView) -> Result<()> {
         let (d, rebuilt) = match self.drawing.take() {
             Some(mut d) => {
                 let changed = d.update(view)?;
@@ -54,15 +55,24 @@ impl ViewPictures {
             }
         };
         let off = self.offscreen.insert(off);
-        let camera = *self
-            .camera
+        self.camera
             .get_or_insert_with(|| default_camera(&d.render.mesh).view(off.aspect()));
+        Ok(())
+    }
+
+    /// Draw `view` now.
+    pub fn image(&mut self, view: TetView) -> Result<RgbaImage> {
+        self.aim(view)?;
+        let (Some(d), Some(off), Some(camera)) = (&self.drawing, &mut self.offscreen, &self.camera)
+        else {
+            anyhow::bail!("offscreen pictures: no view was taken");
+        };
         let settings = RenderSettings {
             overlays: self.overlays,
             stress_max: d.scale,
             ..RenderSettings::default()
         };
-        Ok(off.render_image(&d.state(), &settings, &camera)?)
+        Ok(off.render_image(&d.state(), &settings, camera)?)
     }
 
     /// Draw `view` now and write the PNG to `path`.
