@@ -358,19 +358,22 @@ fn malformed_exercises_are_errors_naming_the_field() {
     );
 }
 
-/// An exercise on a Nakao scene is refused at its `scene` line, saying why (scoring is
-/// defined on an XPBD body's released tets) and where the scene does open.
+/// An exercise on a rheology scene is refused at its `scene` line, saying why (the body
+/// does not cut) and where the scene does open.
 #[test]
-fn an_exercise_on_a_nakao_scene_is_refused_naming_its_scene_line() {
-    let dir = temp_dir("exercise-nakao");
-    let nakao = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut_nakao.ron");
-    let to = format!("\"{}\"", nakao.display());
-    let path = bad_exercise(&dir, "nakao", "\"../slab_layer.ron\"", &to);
+fn an_exercise_on_a_rheology_scene_is_refused_naming_its_scene_line() {
+    let dir = temp_dir("exercise-rheology");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/organ_layers.ron");
+    let to = format!("\"{}\"", scene.display());
+    let path = bad_exercise(&dir, "rheology", "\"../slab_layer.ron\"", &to);
     let o = incise(&["exercise", path.to_str().unwrap(), "--stroke", "unused.ron"]);
     let err = text(&o.stderr);
-    assert!(!o.status.success(), "a Nakao exercise was accepted");
-    assert!(err.contains("nakao.ron:7: scene"), "{err}");
-    assert!(err.contains("is a MassSpring scene"), "{err}");
+    assert!(!o.status.success(), "a rheology exercise was accepted");
+    assert!(err.contains("rheology.ron:7: scene"), "{err}");
+    assert!(
+        err.contains("is a Rheology scene, which does not cut"),
+        "{err}"
+    );
     assert!(err.contains("incise preview"), "{err}");
 }
 
@@ -467,4 +470,60 @@ fn slab_reference_strokes_pass_their_exercises() {
 #[test]
 fn intestine_reference_stroke_passes_its_exercise() {
     reference_passes("intestine_enterotomy");
+}
+
+/// The Nakao plate exercise (a cut surface, not released tets, is scored): the shipped
+/// reference stroke, the blade upright with its heel through the 4 mm plate along the
+/// line, passes with the whole plan cut through; the same stroke 5 mm to the side cuts
+/// nothing of the plan and damages tissue outside the band; lifted 2 mm it leaves the
+/// plate's lower half uncut.
+#[test]
+fn nakao_plate_exercise_scores_the_cut_surface() {
+    reference_passes("plate_line_nakao");
+    let dir = temp_dir("exercise-nakao-plate");
+    let exercise = "config/exercises/plate_line_nakao.ron";
+    let reference = incise_scalpel::load_stroke(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("config/strokes/plate_line_nakao_reference.ron"),
+    )
+    .unwrap();
+    let moved = |by: Vec3| {
+        let keys = reference.keys().iter().map(|k| PoseKey {
+            position: k.position + by,
+            ..*k
+        });
+        Stroke::new(keys.collect()).unwrap()
+    };
+    let good = attempt(&dir, "good", exercise, &reference);
+    assert_eq!(good["method"], "nakao", "{}", good["method"]);
+    assert!(metric(&good, "cut_faces") > 20.0 && metric(&good, "cut_area") > 0.0);
+    assert!(
+        (metric(&good, "max_depth") - 0.004).abs() < 1e-4,
+        "{}",
+        good["metrics"]
+    );
+    assert!(metric(&good, "max_force") > 0.0 && metric(&good, "strokes") == 1.0);
+    let aside = attempt(&dir, "aside", exercise, &moved(Vec3::new(0.0, 0.005, 0.0)));
+    let fails = failed(&aside);
+    assert!(
+        fails.contains(&"mean_deviation".into()) && fails.contains(&"collateral".into()),
+        "{fails:?}"
+    );
+    assert!(metric(&aside, "completion") < 0.1, "{}", aside["metrics"]);
+    let shallow = attempt(
+        &dir,
+        "shallow",
+        exercise,
+        &moved(Vec3::new(0.0, 0.0, 0.002)),
+    );
+    assert!(
+        failed(&shallow).contains(&"depth_error".into()),
+        "{}",
+        shallow["verdict"]
+    );
+    assert!(
+        metric(&shallow, "max_depth") < 0.0035,
+        "{}",
+        shallow["metrics"]
+    );
 }

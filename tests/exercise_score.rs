@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
-use incise::exercise::{LoadedExercise, Metrics, compute_metrics, judge, load_exercise};
+use incise::exercise::{LoadedExercise, Metrics, ToolFrame, compute_metrics, judge, load_exercise};
+use incise::sim_body::{RestCut, RestCutFace};
 use incise_sim::xpbd::FrameStats;
 
 fn slab_depth() -> LoadedExercise {
@@ -29,6 +30,8 @@ fn perfect() -> Metrics {
         max_depth: 0.003,
         collateral_volume: 0.0,
         released_volume: 1e-7,
+        cut_faces: 0,
+        cut_area: 0.0,
         band_volume: 0.03 * 2.0 * 0.003 * 0.0055,
         max_force: 1.0,
         mean_force: 0.5,
@@ -190,7 +193,7 @@ fn metrics_of_a_hand_made_cut_along_the_plan() {
         &ex.exercise,
         &ex.plan,
         &ex.mesh,
-        &vec![false; n],
+        &RestCut::Released(vec![false; n]),
         &[],
         1.0 / 60.0,
     );
@@ -204,7 +207,14 @@ fn metrics_of_a_hand_made_cut_along_the_plan() {
     let on_plan =
         |c: DVec3| (c.y - 0.02).abs() < 0.0015 && (0.025..0.055).contains(&c.x) && c.z > 0.006;
     let released: Vec<bool> = (0..n).map(|t| on_plan(centroid(&ex, t))).collect();
-    let m = compute_metrics(&ex.exercise, &ex.plan, &ex.mesh, &released, &[], 1.0 / 60.0);
+    let m = compute_metrics(
+        &ex.exercise,
+        &ex.plan,
+        &ex.mesh,
+        &RestCut::Released(released.clone()),
+        &[],
+        1.0 / 60.0,
+    );
     assert_eq!(m.released_tets, released.iter().filter(|r| **r).count());
     assert!(m.completion > 0.9, "completion {}", m.completion);
     assert!(
@@ -225,7 +235,14 @@ fn metrics_of_a_hand_made_cut_along_the_plan() {
     let below =
         |c: DVec3| (c.y - 0.02).abs() < 0.0015 && (0.025..0.055).contains(&c.x) && c.z < 0.002;
     let under: Vec<bool> = (0..n).map(|t| below(centroid(&ex, t))).collect();
-    let mb = compute_metrics(&ex.exercise, &ex.plan, &ex.mesh, &under, &[], 1.0 / 60.0);
+    let mb = compute_metrics(
+        &ex.exercise,
+        &ex.plan,
+        &ex.mesh,
+        &RestCut::Released(under.clone()),
+        &[],
+        1.0 / 60.0,
+    );
     let under_volume: f64 = (0..n)
         .filter(|&t| under[t])
         .map(|t| ex.mesh.rest_volume[t] as f64)
@@ -247,7 +264,14 @@ fn metrics_of_a_hand_made_cut_along_the_plan() {
     let extra: Vec<usize> = (0..n).filter(|&t| aside(centroid(&ex, t))).collect();
     let mut both = released.clone();
     extra.iter().for_each(|&t| both[t] = true);
-    let m2 = compute_metrics(&ex.exercise, &ex.plan, &ex.mesh, &both, &[], 1.0 / 60.0);
+    let m2 = compute_metrics(
+        &ex.exercise,
+        &ex.plan,
+        &ex.mesh,
+        &RestCut::Released(both),
+        &[],
+        1.0 / 60.0,
+    );
     let volume: f64 = extra.iter().map(|&t| ex.mesh.rest_volume[t] as f64).sum();
     assert!(!extra.is_empty());
     assert!(
@@ -289,8 +313,8 @@ fn tool_figures_count_strokes_across_contact_gaps() {
         &ex.exercise,
         &ex.plan,
         &ex.mesh,
-        &vec![false; n],
-        &frames,
+        &RestCut::Released(vec![false; n]),
+        &frames.iter().map(ToolFrame::of_xpbd).collect::<Vec<_>>(),
         0.5,
     );
     assert_eq!(m.strokes, 2);
@@ -304,4 +328,75 @@ fn tool_figures_count_strokes_across_contact_gaps() {
     // First to last contact, frames 10..=34, 0.5 s each.
     assert!((m.duration - 12.5).abs() < 1e-9, "{}", m.duration);
     assert_eq!(m.force_series.len(), 40);
+}
+
+/// A cut surface (a Nakao body's, at rest) read against the plan: a vertical wall 3 mm
+/// deep under slab_depth's line is the whole plan cut to depth with no collateral; faces
+/// 1 cm aside are collateral, each tet they bound counted once; a face buried 5 mm deep
+/// (no corner at the surface) deepens the cut but leaves no trace.
+#[test]
+fn metrics_of_a_hand_made_cut_surface() {
+    let ex = slab_depth();
+    let wall = |y: f64, x0: f64, x1: f64, top: f64, bottom: f64, first_tet: u32| {
+        let steps = ((x1 - x0) / 0.001).round() as usize;
+        (0..steps)
+            .flat_map(|k| {
+                let (a, b) = (x0 + 0.001 * k as f64, x0 + 0.001 * (k + 1) as f64);
+                let p = |x: f64, z: f64| DVec3::new(x, y, z);
+                let tet = first_tet + k as u32;
+                [
+                    [p(a, top), p(b, top), p(a, bottom)],
+                    [p(b, top), p(b, bottom), p(a, bottom)],
+                ]
+                .map(|corners| RestCutFace {
+                    corners,
+                    tet,
+                    tet_volume: 1e-9,
+                })
+            })
+            .collect::<Vec<_>>()
+    };
+    let metrics = |faces: Vec<RestCutFace>| {
+        compute_metrics(
+            &ex.exercise,
+            &ex.plan,
+            &ex.mesh,
+            &RestCut::Faces(faces),
+            &[],
+            1.0 / 60.0,
+        )
+    };
+    let on_plan = wall(0.02, 0.025, 0.055, 0.008, 0.005, 0);
+    let m = metrics(on_plan.clone());
+    assert!(m.completion > 0.99, "completion {}", m.completion);
+    assert_eq!((m.cut_faces, m.trace_faces, m.released_tets), (60, 60, 0));
+    assert!((m.max_depth - 0.003).abs() < 1e-9, "depth {}", m.max_depth);
+    // Face centroids lie up to half a sample spacing (0.25 mm) along the plan from a sample.
+    let (dev, depth_err) = (m.mean_deviation.unwrap(), m.mean_depth_error.unwrap());
+    assert!(
+        depth_err < 1e-9 && dev < 3e-4,
+        "deviation {dev}, depth error {depth_err}"
+    );
+    assert!(
+        (m.cut_area - 0.03 * 0.003).abs() < 1e-9,
+        "area {}",
+        m.cut_area
+    );
+    assert_eq!(m.collateral_volume, 0.0);
+    // Ten faces 1 cm aside, two per tet: five tets of 1e-9 m³ each.
+    let mut aside = on_plan.clone();
+    aside.extend(wall(0.03, 0.030, 0.035, 0.008, 0.005, 100));
+    let m = metrics(aside);
+    assert!(
+        (m.collateral_volume - 5e-9).abs() < 1e-15,
+        "{}",
+        m.collateral_volume
+    );
+    assert!(m.max_deviation.unwrap() > 0.009, "{:?}", m.max_deviation);
+    // Buried 4–5 mm deep under the first centimetre: deeper there, no new trace.
+    let mut buried = on_plan;
+    buried.extend(wall(0.02, 0.025, 0.035, 0.004, 0.003, 200));
+    let m = metrics(buried);
+    assert_eq!(m.trace_faces, 60, "a buried face counted in the trace");
+    assert!((m.max_depth - 0.005).abs() < 1e-9, "depth {}", m.max_depth);
 }

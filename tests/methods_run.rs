@@ -118,3 +118,61 @@ fn rheology_press_reaches_the_indenter_depth_and_creeps_back() {
     assert!(end > 1e-4, "no residual dent: {end} m");
     assert_eq!(report["rheology"]["residual_dent_m"].as_f64().unwrap(), end);
 }
+
+/// A stroke file drives the Nakao blade as a hand would (the shipped plate exercise's
+/// reference stroke: the blade upright along an 8 cm line), in place of the scene's
+/// scripted 14 cm cut; a rheology scene refuses it, saying what it drives.
+#[test]
+fn a_stroke_file_drives_the_nakao_blade_and_rheology_refuses_it() {
+    let dir = temp_dir("methods-run-stroke");
+    let stroke =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("config/strokes/plate_line_nakao_reference.ron");
+    let out = dir.join("nakao");
+    let o = incise(&[
+        "run",
+        "config/plate_cut_nakao.ron",
+        "--stroke",
+        stroke.to_str().unwrap(),
+        "--frames",
+        "341",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    // The stroke's line runs from x = -4 to +4 cm; the scene's own cut from -7 to +7 cm.
+    let frames = r["frames"].as_array().unwrap();
+    let touching = frames.iter().filter(|f| f["blade_contact"] == true).count();
+    assert!(
+        touching > 250,
+        "{touching} frames with the blade in the plate"
+    );
+    let force = frames
+        .iter()
+        .filter_map(|f| f["tool_force"].as_array())
+        .count();
+    assert_eq!(
+        force,
+        frames.len(),
+        "a hand-held blade reports its force every frame"
+    );
+    let cut_area = r["nakao"]["cut_area_m2"].as_f64().unwrap();
+    // Both sides of an 8 cm × 4 mm wound: 6.4 cm²; the scene's 14 cm cut would be 11 cm².
+    assert!((5e-4..8e-4).contains(&cut_area), "cut area {cut_area} m²");
+    let o = incise(&[
+        "run",
+        "config/organ_layers.ron",
+        "--stroke",
+        stroke.to_str().unwrap(),
+        "--out",
+        dir.join("rheology").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success(), "a rheology scene took a stroke file");
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("--stroke is for the XPBD scalpel and the Nakao blade"),
+        "{err}"
+    );
+}

@@ -7,19 +7,18 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use incise_sim::xpbd::FrameStats;
 
 use super::decal::PlanDecal;
 use super::history::{self, HistoryEntry};
 use super::load::{LoadedExercise, load_exercise};
-use super::metrics;
+use super::metrics::{self, ToolFrame};
 use super::report_html::{self, CutImages};
 pub use super::result::ExerciseResult;
 use super::score;
 use crate::pictures::screenshots::ImageSize;
-use crate::report::FrameData;
 use crate::run::{RunOptions, run_scene};
-use crate::sim_body::DeviceChoice;
+use crate::scene::ModelChoice;
+use crate::sim_body::{DeviceChoice, RestCut};
 
 /// Simulated time after the stroke's last key, so the tissue settles and late releases
 /// are counted, s.
@@ -80,33 +79,30 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
         record_stroke: None,
         inject_gpu_loss_at: None,
         inject_nan_at: None,
-        screenshot_decal: Some(PlanDecal::new(&ex.plan, &ex.mesh)),
+        // The plan is drawn on XPBD bodies (a Nakao cut remodels the tets it is laid in).
+        screenshot_decal: matches!(ex.scene.model, ModelChoice::Xpbd)
+            .then(|| PlanDecal::new(&ex.plan, &ex.mesh)),
     })
     .with_context(|| format!("{}: running the attempt", opts.exercise.display()))?;
     let report = outcome.report;
-    let mut released = vec![false; ex.mesh.tet_count()];
-    for &t in &report.released_tets {
-        if let Some(r) = released.get_mut(t as usize) {
-            *r = true;
-        }
-    }
-    let stats: Vec<_> = report
+    let cut = outcome.rest_cut.with_context(|| {
+        format!(
+            "{}: a {} body leaves no cut to score",
+            ex.scene_path.display(),
+            report.method.name()
+        )
+    })?;
+    let tool: Vec<ToolFrame> = report
         .frames
         .iter()
-        .filter_map(|f| match &f.stats {
-            FrameData::Xpbd(s) => Some(s.clone()),
-            FrameData::Edges(_) => None,
-        })
+        .map(|f| ToolFrame::of(&f.stats))
         .collect();
-    if stats.len() != report.frames.len() {
-        bail!("{}: exercises need an Xpbd scene", ex.scene_path.display());
-    }
     let result = score_attempt(
         &ex,
         &opts.stroke.display().to_string(),
         report.device.clone(),
-        &released,
-        &stats,
+        &cut,
+        &tool,
         frames,
     )?;
     let first = opts.out.join("frame_00000.png");
@@ -121,19 +117,21 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
     save_attempt(&opts.out, result, &pictures, &opts.history)
 }
 
-/// Score an attempt on `ex` from the simulation state it left: `released[t]` for every
-/// tet of the exercise's mesh, the statistics of each of the `frames` simulated frames
-/// (`stats`), the stroke (`stroke_label`, as written in the results) and the solver's
-/// `device`. The one scoring of the command line, the preview and the headset.
+/// Score an attempt on `ex` from what its body cut (`cut`, at rest: released tets of the
+/// exercise's mesh or a cut surface), the tool figures of each of the `frames` simulated
+/// frames (`tool`), the stroke (`stroke_label`, as written in the results) and the
+/// solver's `device`. The one scoring of the command line, the preview and the headset.
 pub fn score_attempt(
     ex: &LoadedExercise,
     stroke_label: &str,
     device: String,
-    released: &[bool],
-    stats: &[FrameStats],
+    cut: &RestCut,
+    tool: &[ToolFrame],
     frames: u64,
 ) -> Result<ExerciseResult> {
-    if released.len() != ex.mesh.tet_count() {
+    if let RestCut::Released(released) = cut
+        && released.len() != ex.mesh.tet_count()
+    {
         bail!(
             "{}: the attempt's body has {} tets, the exercise's mesh {}: not the exercise's \
              scene",
@@ -143,11 +141,12 @@ pub fn score_attempt(
         );
     }
     let dt = ex.scene.solver.frame_dt as f64;
-    let metrics = metrics::compute(&ex.exercise, &ex.plan, &ex.mesh, released, stats, dt);
+    let metrics = metrics::compute(&ex.exercise, &ex.plan, &ex.mesh, cut, tool, dt);
     let verdict = score::judge(&ex.exercise, &metrics);
     let e = &ex.exercise;
     Ok(ExerciseResult {
         exercise: e.name.clone(),
+        method: ex.scene.model.method(),
         exercise_file: ex.path.display().to_string(),
         description: e.description.clone(),
         scene_file: ex.scene_path.display().to_string(),

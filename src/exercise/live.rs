@@ -12,11 +12,11 @@ use incise_sim::xpbd::FrameStats;
 use incise_xr::RgbaImage;
 
 use super::{
-    Attempt, CutImages, LoadedExercise, PlanDecal, ReferenceStyle, Standing, load_exercise,
-    read_history, reference_stroke, render_card, save_attempt, score_attempt,
+    Attempt, CutImages, LoadedExercise, PlanDecal, ReferenceStyle, Standing, ToolFrame,
+    load_exercise, read_history, reference_stroke, render_card, save_attempt, score_attempt,
 };
 use crate::pictures::screenshots::Screenshots;
-use crate::sim_body::Body;
+use crate::sim_body::{Body, RestCut};
 
 /// Where a live attempt's scalpel path is recorded: the preview's hand tool, the XR
 /// mode's controller.
@@ -171,13 +171,14 @@ impl LiveExercise {
         let dir = new_attempt_dir(out_root, name)?;
         let stroke = dir.join("stroke.ron");
         hand.save_recording(&stroke)?;
-        let released: Vec<bool> = body.solver().cut().live().iter().map(|l| !l).collect();
+        let released = body.solver().cut().live().iter().map(|l| !l).collect();
+        let tool: Vec<ToolFrame> = running.stats.iter().map(ToolFrame::of_xpbd).collect();
         let result = score_attempt(
             &self.exercise,
             &stroke.display().to_string(),
             body.device(),
-            &released,
-            &running.stats,
+            &RestCut::Released(released),
+            &tool,
             frames,
         )?;
         let (before, after) = (dir.join("before.png"), dir.join("after.png"));

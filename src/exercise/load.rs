@@ -9,7 +9,7 @@ use incise_sim::ron_file;
 
 use super::model::Exercise;
 use super::plan::{Plan, RestSurface};
-use crate::scene::{Scene, SceneError, load_scene, locate, raw_mesh};
+use crate::scene::{ModelChoice, Scene, SceneError, load_scene, locate, raw_mesh};
 
 /// An exercise ready to score: the file, its scene and the plan on the organ's surface.
 pub struct LoadedExercise {
@@ -27,8 +27,8 @@ pub struct LoadedExercise {
     pub plan: Plan,
 }
 
-/// Read, validate and place an exercise: its fields, its scene (which must have a
-/// scalpel) and its plan (every point within `surface_tolerance` of the organ's surface).
+/// Read, validate and place an exercise: its fields, its scene (an XPBD scene with a
+/// scalpel, or a Nakao scene, whose blade a stroke file drives) and its plan (every point within `surface_tolerance` of the organ's surface).
 pub fn load_exercise(path: &Path) -> Result<LoadedExercise> {
     let text = ron_file::read(path).map_err(SceneError::from)?;
     let exercise = parse_exercise(&text, path)?;
@@ -49,19 +49,20 @@ pub fn load_exercise(path: &Path) -> Result<LoadedExercise> {
         .into());
     }
     let scene = load_scene(&scene_path).with_context(|| format!("{}: scene", path.display()))?;
-    if let Some(model) = scene.model.non_xpbd_name() {
+    if let ModelChoice::Rheology(_) = scene.model {
         return Err(value_err(
             "scene",
             locate(&text, "scene"),
             format!(
-                "{} is a {model} scene: exercises are scored on an XPBD body's released tets \
-                 (docs/scoring.md); open it with `incise preview`, `incise xr` or `incise run`",
+                "{} is a Rheology scene, which does not cut: exercises are scored on what an \
+                 XPBD body released or a MassSpring (Nakao) body cut open (docs/scoring.md); \
+                 open it with `incise preview`, `incise xr` or `incise run`",
                 scene_path.display()
             ),
         )
         .into());
     }
-    if scene.tool.is_none() {
+    if scene.tool.is_none() && matches!(scene.model, ModelChoice::Xpbd) {
         return Err(value_err(
             "scene",
             locate(&text, "scene"),

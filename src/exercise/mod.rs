@@ -4,6 +4,7 @@
 //! local history of attempts. Definitions: docs/scoring.md.
 
 mod attempt;
+mod cut_reading;
 mod decal;
 mod history;
 mod live;
@@ -12,6 +13,7 @@ mod metrics;
 mod model;
 mod plan;
 mod reference;
+mod reference_blade;
 mod report_html;
 mod result;
 mod result_card;
@@ -24,7 +26,7 @@ pub use history::{
 };
 pub use live::{Finished, LiveExercise, StrokeSource};
 pub use load::{LoadedExercise, load_exercise, parse_exercise};
-pub use metrics::{Metrics, STROKE_GAP_FRAMES, compute as compute_metrics};
+pub use metrics::{Metrics, STROKE_GAP_FRAMES, ToolFrame, compute as compute_metrics};
 pub use model::{Exercise, PassThresholds, Tolerance};
 pub use plan::{Plan, PlanCoords, PlanSample, RestSurface};
 pub use reference::{ReferenceStyle, reference_stroke, write_reference_stroke};

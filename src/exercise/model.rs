@@ -58,7 +58,8 @@ pub struct PassThresholds {
     pub max_deviation: f32,
     /// Largest mean |depth − target| along the cut part of the plan, m.
     pub depth_error: f32,
-    /// Largest volume of tissue released outside the tolerance band, m³.
+    /// Largest volume of tissue cut outside the tolerance band (released tets, or the tets a
+    /// cut surface bounds there), m³.
     pub collateral: f32,
     /// Largest contact force on the blade, N.
     pub max_force: f32,

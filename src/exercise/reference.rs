@@ -1,7 +1,8 @@
 //! A reference stroke for an exercise: the scene's scalpel drawn along the plan at the
 //! target depth, held as a No. 10 is held to cut with its belly (handle raised from the
 //! surface), so that the part of the edge below the surface lies along the plan. What a
-//! good attempt looks like, for any exercise; `incise exercise --reference-stroke`.
+//! good attempt looks like, for any exercise; `incise exercise --reference-stroke`. (A
+//! Nakao scene's straight blade: `reference_blade`.)
 
 use std::path::Path;
 
@@ -10,6 +11,8 @@ use glam::{DVec3, Mat3, Quat, Vec3};
 use incise_scalpel::{PoseKey, Stroke, load_tool};
 
 use super::load::LoadedExercise;
+use super::reference_blade::blade_reference;
+use crate::scene::ModelChoice;
 
 /// Key spacing along the plan, m.
 const KEY_SPACING: f64 = 0.001;
@@ -102,6 +105,9 @@ pub fn reference_stroke(ex: &LoadedExercise, style: ReferenceStyle) -> Result<St
     }
     if !(style.speed.is_finite() && style.speed > 0.0) {
         bail!("speed must be > 0 m/s, got {}", style.speed);
+    }
+    if let ModelChoice::MassSpring(ms) = &ex.scene.model {
+        return blade_reference(ex, ms, style);
     }
     let spec = ex
         .scene

@@ -5,12 +5,15 @@ use serde::Serialize;
 use super::metrics::Metrics;
 use super::model::{PassThresholds, Tolerance};
 use super::score::Verdict;
+use crate::sim_body::Method;
 
 /// Everything `result.json` holds.
 #[derive(Debug, Clone, Serialize)]
 pub struct ExerciseResult {
     /// Exercise name.
     pub exercise: String,
+    /// The simulation method of the exercise's scene ("xpbd" or "nakao").
+    pub method: Method,
     /// Exercise file.
     pub exercise_file: String,
     /// The exercise's description.

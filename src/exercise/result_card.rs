@@ -187,6 +187,8 @@ mod tests {
             max_depth: 0.004,
             collateral_volume: 2e-8,
             released_volume: 3e-7,
+            cut_faces: 0,
+            cut_area: 0.0,
             band_volume: 0.03 * 0.006 * 0.0055,
             max_force: 1.2,
             mean_force: 0.6,
@@ -200,6 +202,7 @@ mod tests {
     fn result(m: Metrics) -> ExerciseResult {
         let e = exercise();
         ExerciseResult {
+            method: crate::sim_body::Method::Xpbd,
             exercise: e.name.clone(),
             exercise_file: "e.ron".into(),
             description: String::new(),

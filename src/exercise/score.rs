@@ -142,7 +142,7 @@ pub fn judge(ex: &Exercise, m: &Metrics) -> Verdict {
         name: "collateral",
         passed: m.collateral_volume <= p.collateral as f64,
         detail: format!(
-            "{:.1} mm³ released outside the tolerance band (allowed ≤ {:.1} mm³)",
+            "{:.1} mm³ of tissue cut outside the tolerance band (allowed ≤ {:.1} mm³)",
             m.collateral_volume * 1e9,
             p.collateral as f64 * 1e9
         ),

@@ -291,7 +291,7 @@ mod tests {
         std::fs::copy(config.join("rheology.ron"), dir.join("soft.ron")).unwrap();
         std::fs::copy(config.join("plate_cut.ron"), dir.join("cut.ron")).unwrap();
         assert_eq!(names(&dir), ["cut.ron"]);
-        assert_eq!(names(&config.join("exercises")).len(), 3);
+        assert_eq!(names(&config.join("exercises")).len(), 4);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

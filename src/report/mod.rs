@@ -82,9 +82,14 @@ pub struct EdgeFrameStats {
     /// runs on the haptic thread).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solve_ms: Option<f64>,
-    /// Latest force of the tissue on the haptic tool (x, y, z), N; haptic-rate runs only.
+    /// Latest force of the tissue on the tool (x, y, z), N: a haptic-rate run's haptic
+    /// tool, or a Nakao blade held by a hand (or a stroke file).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tool_force: Option<[f64; 3]>,
+    /// Whether the engaged blade touched the tissue (its edge within half a mean edge
+    /// length of a node); frame-by-frame Nakao runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blade_contact: Option<bool>,
     /// Haptic loops run so far; haptic-rate runs only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub haptic_loops: Option<u64>,

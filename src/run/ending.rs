@@ -7,6 +7,7 @@ use anyhow::{Result, bail};
 
 use super::options::{RunOptions, RunOutcome};
 use crate::report::Report;
+use crate::sim_body::RestCut;
 
 /// Why a run stopped before its last frame.
 #[derive(Debug, Clone)]
@@ -21,7 +22,7 @@ pub enum RunEnd {
 }
 
 /// Record how the run ended in `report` ("completed", "failed" with the error, or
-/// "interrupted"), write it, and return the outcome; after a failure, the error naming
+/// "interrupted"), write it, and return the outcome with the body's `rest_cut`; after a failure, the error naming
 /// the scene and saying that the output written so far is kept; after Ctrl-C, an
 /// [`Interrupted`](crate::interrupt::Interrupted) error (exit 130).
 pub fn finish(
@@ -29,6 +30,7 @@ pub fn finish(
     report_path: PathBuf,
     stopped: Option<RunEnd>,
     opts: &RunOptions,
+    rest_cut: Option<RestCut>,
 ) -> Result<RunOutcome> {
     let (status, error) = match &stopped {
         None => ("completed", None),
@@ -45,6 +47,7 @@ pub fn finish(
         None => Ok(RunOutcome {
             report_path,
             report,
+            rest_cut,
         }),
         Some(RunEnd::Failed(e)) => bail!(
             "{}: {e} (output so far kept in {})",

@@ -31,7 +31,14 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     if let Some(line) = closing.filter(|_| !opts.quiet && stopped.is_none()) {
         eprintln!("{line}");
     }
-    finish(report, opts.out.join("report.json"), stopped, opts)
+    let rest_cut = body.rest_cut();
+    finish(
+        report,
+        opts.out.join("report.json"),
+        stopped,
+        opts,
+        rest_cut,
+    )
 }
 
 /// What of `opts` the body is opened with.
@@ -46,20 +53,29 @@ fn open_options(opts: &RunOptions) -> OpenOptions {
     }
 }
 
-/// Strokes drive and record the XPBD scalpel only: refused for the other methods, whose
-/// tools follow their own scripts.
+/// A stroke file drives the XPBD scalpel or the Nakao blade; recording a stroke is the
+/// XPBD scalpel's (the Nakao blade shows no turn). Refused for the methods without them.
 fn refuse_xpbd_only_options(model: &ModelChoice, opts: &RunOptions) -> Result<()> {
     let Some(method) = model.non_xpbd_name() else {
         return Ok(());
     };
-    for (given, flag) in [
-        (opts.stroke.is_some(), "--stroke"),
-        (opts.record_stroke.is_some(), "--record-stroke"),
+    let nakao = matches!(model, ModelChoice::MassSpring(_));
+    for (given, flag, drives) in [
+        (
+            opts.stroke.is_some() && !nakao,
+            "--stroke",
+            "the XPBD scalpel and the Nakao blade",
+        ),
+        (
+            opts.record_stroke.is_some(),
+            "--record-stroke",
+            "the XPBD scalpel's poses",
+        ),
     ] {
         if given {
             bail!(
-                "{}: {flag} drives the XPBD scalpel; this scene's model is {method}, whose \
-                 tool follows model.stroke or model.indenter",
+                "{}: {flag} is for {drives}; this scene's model is {method}, whose tool \
+                 follows model.stroke or model.indenter",
                 opts.scene.display()
             );
         }

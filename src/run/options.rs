@@ -6,6 +6,7 @@ use crate::exercise::PlanDecal;
 use crate::pictures::screenshots::ImageSize;
 use crate::report::Report;
 use crate::sim_body::DeviceChoice;
+use crate::sim_body::RestCut;
 
 /// Frames between checkpoints of report.json and the recorded stroke (1 s at 60 Hz).
 pub const CHECKPOINT_FRAMES: u64 = 60;
@@ -54,4 +55,7 @@ pub struct RunOutcome {
     pub report_path: PathBuf,
     /// The report.
     pub report: Report,
+    /// What the body cut, at rest (for scoring an exercise; `None`: its method does not
+    /// cut, or a haptic thread held its state).
+    pub rest_cut: Option<RestCut>,
 }

@@ -26,6 +26,16 @@ pub enum ModelChoice {
 }
 
 impl ModelChoice {
+    /// The simulation method the model runs.
+    pub fn method(&self) -> crate::sim_body::Method {
+        use crate::sim_body::Method;
+        match self {
+            ModelChoice::Xpbd => Method::Xpbd,
+            ModelChoice::MassSpring(_) => Method::Nakao,
+            ModelChoice::Rheology(_) => Method::Rheology,
+        }
+    }
+
     /// The model's name in a scene file when it is not XPBD (`MassSpring`, `Rheology`);
     /// `None` for XPBD.
     pub fn non_xpbd_name(&self) -> Option<&'static str> {

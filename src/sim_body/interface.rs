@@ -7,6 +7,7 @@ use std::path::Path;
 
 pub use super::method::Method;
 use super::outcome::Outcome;
+use super::rest_cut::RestCut;
 use crate::exercise::PlanDecal;
 use crate::pictures::run_pictures::RunPictures;
 use crate::pictures::screenshots::ImageSize;
@@ -157,6 +158,12 @@ pub trait SimBody {
     /// The body's result now, in its method's terms, for checking that a replay or a
     /// rollback reproduces it bit for bit (`None`: a haptic thread holds the state).
     fn outcome(&self) -> Option<Outcome>;
+
+    /// What the body has cut, in rest coordinates, for scoring an exercise (`None`: the
+    /// method does not cut, or a haptic thread holds the state).
+    fn rest_cut(&self) -> Option<RestCut> {
+        None
+    }
 
     /// Inject `fault` (testing aid); an error when the method has no such fault.
     fn inject(&mut self, fault: Fault) -> anyhow::Result<()>;

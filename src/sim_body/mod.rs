@@ -14,6 +14,7 @@ pub mod nakao_surface;
 pub mod open;
 pub mod outcome;
 pub mod recorded;
+pub mod rest_cut;
 pub mod rheology;
 pub mod rheology_open;
 pub mod vertex_field;
@@ -26,4 +27,5 @@ pub use interface::{
 pub use method::Method;
 pub use open::open;
 pub use outcome::Outcome;
+pub use rest_cut::{RestCut, RestCutFace};
 pub use xpbd_device::{Body, DeviceChoice, auto_device};

@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use glam::{DVec3, Vec3};
+use incise_scalpel::Stroke;
 use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::mass_spring::{
@@ -21,10 +22,11 @@ use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, op
 use incise_sim::nakao_cut::{BladePose, Cutter};
 
 use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
-use super::nakao_blade::{Blade, tool_point};
+use super::nakao_blade::{Blade, stroke_hand, tool_point, touches};
 use super::nakao_outcome::model_outcome;
 use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};
 use super::outcome::Outcome;
+use super::rest_cut::{RestCut, cut_faces_at_rest};
 use crate::report::localisation::{LocalisationInfo, LoopSample, LoopSplit};
 use crate::report::{EdgeFrameStats, FrameData, NakaoInfo, Report};
 use crate::scene::{Localisation, MassSpringScene};
@@ -61,6 +63,13 @@ pub struct NakaoBody {
     force: Option<DVec3>,
     /// How a hand's tool is coupled to the tissue (the scene's `haptic_contact`).
     coupling: ToolCoupling,
+    /// A stroke file that drives the blade as a hand would, in place of the scene's script.
+    hand_stroke: Option<Stroke>,
+    /// How near a node the blade's edge must pass to touch the tissue: half the mean
+    /// reference edge length, m.
+    reach: f64,
+    /// Whether the engaged blade touched the tissue in the last frame.
+    touched: bool,
 }
 
 impl NakaoBody {
@@ -72,6 +81,7 @@ impl NakaoBody {
             .sum();
         let mut last_state = DynamicState::default();
         model.save_state(&mut last_state);
+        let reach = 0.5 * mean_edge_length(&model);
         NakaoBody {
             last_good: model.clone(),
             last_state,
@@ -92,7 +102,17 @@ impl NakaoBody {
                 contact: ms.haptic_contact,
                 ..HapticConfig::default()
             }),
+            hand_stroke: None,
+            reach,
+            touched: false,
         }
+    }
+
+    /// The body with its blade driven by `stroke` (a recorded or reference stroke file)
+    /// wherever the scene's script would drive it.
+    pub fn with_stroke(mut self, stroke: Stroke) -> NakaoBody {
+        self.hand_stroke = Some(stroke);
+        self
     }
 
     /// The model as of the last completed frame.
@@ -105,9 +125,11 @@ impl NakaoBody {
     // PHYSICS.md §2.3–2.4: the cutter remodels and subdivides along the blade's sweep.
     fn cut(&mut self, tool: &ToolInput) -> (f64, bool) {
         let Some((pose, engaged, begin)) = self.blade.at(tool, self.model.time(), self.pose) else {
+            self.touched = false;
             return (0.0, false);
         };
         self.pose = Some(pose);
+        self.touched = engaged && touches(&self.model, pose, self.reach);
         if engaged && !self.cutting {
             self.cutter.begin(&self.model, begin);
             self.cutting = true;
@@ -172,6 +194,8 @@ impl NakaoBody {
             force_ms: Some(sample.split.force_ms),
             integrate_ms: Some(sample.split.integrate_ms),
             cut_ms: Some(sample.split.cut_ms),
+            tool_force: self.force.map(|f| f.to_array()),
+            blade_contact: Some(self.touched),
             ..EdgeFrameStats::default()
         }
     }
@@ -231,6 +255,10 @@ impl SimBody for NakaoBody {
 
     fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError> {
         let t0 = Instant::now();
+        let tool = &match (&self.hand_stroke, tool) {
+            (Some(s), ToolInput::Script) => stroke_hand(s, self.model.time() + self.frame_dt),
+            _ => *tool,
+        };
         let (cut_ms, remodelled) = self.cut(tool);
         self.force = matches!(tool, ToolInput::Hand { .. }).then(|| self.couple());
         let steps = (self.frame_dt / self.model.stable_dt()).ceil().max(1.0) as u32;
@@ -295,6 +323,10 @@ impl SimBody for NakaoBody {
 
     fn outcome(&self) -> Option<Outcome> {
         Some(model_outcome(&self.model))
+    }
+
+    fn rest_cut(&self) -> Option<RestCut> {
+        Some(cut_faces_at_rest(&self.model))
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {
@@ -391,6 +423,17 @@ pub fn counts_into(m: &MassSpringModel, report: &mut Report, frames: u64) -> Str
         "mass-spring: {} nodes, {} tets, {} edges after {frames} frames",
         after.nodes, after.tets, after.edges
     )
+}
+
+/// Mean reference length of `m`'s springs (its tet edges), m.
+fn mean_edge_length(m: &MassSpringModel) -> f64 {
+    let x = m.reference_positions();
+    let (sum, n) = (0..m.node_count())
+        .flat_map(|i| m.springs_of(i).iter().map(move |s| (i, s.node as usize)))
+        .fold((0.0, 0usize), |(sum, n), (i, j)| {
+            (sum + (x[i] - x[j]).length(), n + 1)
+        });
+    if n == 0 { 0.0 } else { sum / n as f64 }
 }
 
 /// The localised loop of a scene's setting (`None` for `Whole`).

@@ -4,7 +4,9 @@
 //! the tool).
 
 use glam::{DQuat, DVec3, Quat};
+use incise_scalpel::Stroke;
 use incise_sim::contact::ToolPose;
+use incise_sim::mass_spring::MassSpringModel;
 use incise_sim::nakao_cut::BladePose;
 
 use super::interface::ToolInput;
@@ -27,6 +29,11 @@ impl Blade {
             .as_ref()
             .map_or(DEFAULT_EDGE, |s| (s.tip - s.heel).as_dvec3());
         Blade { stroke, edge }
+    }
+
+    /// The edge from heel to tip when the tool is unturned, m.
+    pub fn edge(&self) -> DVec3 {
+        self.edge
     }
 
     /// Where `tool` puts the blade at simulated time `t`, whether it cuts, and where a cut
@@ -61,6 +68,26 @@ impl Blade {
 /// of its cutting edge.
 pub fn tool_point(pose: BladePose) -> DVec3 {
     (pose.heel + pose.tip) * 0.5
+}
+
+/// What a stroke file does to the blade at simulated time `t`, as a hand would: the tool
+/// at the stroke's pose, cutting from the stroke's first key to its last.
+pub fn stroke_hand(stroke: &Stroke, t: f64) -> ToolInput {
+    ToolInput::Hand {
+        pose: stroke.pose_at(t),
+        engaged: t >= stroke.start_time() && t <= stroke.end_time(),
+    }
+}
+
+/// Whether blade `pose` touches `model`'s tissue: a point of its edge (heel, tip and
+/// three between) within `reach` of a node.
+pub fn touches(model: &MassSpringModel, pose: BladePose, reach: f64) -> bool {
+    (0..=4).any(|k| {
+        let p = pose.heel.lerp(pose.tip, k as f64 / 4.0);
+        model
+            .nearest_node(p)
+            .is_some_and(|i| (model.positions()[i as usize] - p).length() <= reach)
+    })
 }
 
 /// The tool pose that shows blade `pose`: at its tip, unturned (`None`: no blade yet).

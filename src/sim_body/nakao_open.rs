@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result, anyhow, bail};
 use incise_sim::mass_spring::{AxisMask, MassSpringModel, MassSpringParams};
 use incise_sim::nakao_cut::measure::counts;
 use incise_sim::{MeshBuildReport, TetMesh};
@@ -50,6 +50,11 @@ pub fn open(
     });
     let frame_dt = scene.solver.frame_dt as f64;
     let body: Box<dyn SimBody> = match opts.haptic_rate {
+        Some(_) if opts.stroke.is_some() => bail!(
+            "{}: --haptic-rate moves the haptic tool along model.stroke; a stroke file drives \
+             the frame-by-frame body only",
+            path.display()
+        ),
         Some(rate) => {
             let stroke = ms.stroke.clone().ok_or_else(|| {
                 anyhow!(
@@ -60,7 +65,13 @@ pub fn open(
             })?;
             Box::new(NakaoHapticBody::spawn(model, ms, stroke, rate, frame_dt))
         }
-        None => Box::new(NakaoBody::new(model, ms, frame_dt)),
+        None => {
+            let body = NakaoBody::new(model, ms, frame_dt);
+            match &opts.stroke {
+                Some(file) => Box::new(body.with_stroke(incise_scalpel::load_stroke(file)?)),
+                None => Box::new(body),
+            }
+        }
     };
     Ok((body, report))
 }

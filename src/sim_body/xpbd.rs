@@ -16,6 +16,7 @@ use super::interface::{
     Fault, Method, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
 };
 use super::outcome::{Outcome, StateHash};
+use super::rest_cut::RestCut;
 use super::vertex_field::vertex_mean;
 use super::xpbd_device::Body;
 use crate::exercise::PlanDecal;
@@ -279,6 +280,11 @@ impl SimBody for XpbdBody {
                 .finish(),
             released: Some(released.len()),
         })
+    }
+
+    fn rest_cut(&self) -> Option<RestCut> {
+        let live = self.body.solver().cut().live();
+        Some(RestCut::Released(live.iter().map(|l| !l).collect()))
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {
