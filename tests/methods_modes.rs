@@ -193,6 +193,7 @@ fn xpbd_headset_releases_tets() {
     let r: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("xr_report.json")).unwrap()).unwrap();
     assert!(r["released_tets"].as_u64().unwrap() > 20, "{stdout}");
+    assert_eq!(r["method"], "xpbd", "{r}");
 }
 
 #[test]
