@@ -8,6 +8,7 @@ pub mod frame_loop;
 pub mod in_frame;
 pub mod latest;
 pub mod method_session;
+pub mod method_stepper;
 pub mod method_thread;
 pub mod script;
 pub mod sim_mode;
