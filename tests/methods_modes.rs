@@ -11,6 +11,7 @@
 
 mod common;
 
+use std::collections::HashMap;
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -62,16 +63,17 @@ fn preview(name: &str, scene: &str, frames: u32) -> Option<String> {
     Some(text(&o.stdout))
 }
 
+/// `incise xr SCENE --simulated-headset SCRIPT --out OUT` and the `extra` arguments.
+fn run_xr(scene: &str, script: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["xr", scene, "--simulated-headset", script.to_str().unwrap()];
+    args.extend(["--out", out.to_str().unwrap()]);
+    args.extend(extra);
+    incise(&args)
+}
+
 /// `incise xr SCENE --simulated-headset SCRIPT --out OUT`; its stdout, or `None`.
 fn headset(scene: &str, script: &Path, out: &Path) -> Option<String> {
-    let o = incise(&[
-        "xr",
-        scene,
-        "--simulated-headset",
-        script.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_xr(scene, script, out, &[]);
     if no_adapter(&o) {
         return None;
     }
@@ -116,6 +118,35 @@ fn number_after(line: &str, before: &str) -> f64 {
 /// The report a headset session wrote.
 fn report(out: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap()
+}
+
+/// A session's `frames.csv`: each row by column name (an empty cell is NaN).
+fn frame_rows(out: &Path) -> Vec<HashMap<String, f64>> {
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    lines
+        .map(|l| {
+            let cells = l.split(',').map(|c| c.parse().unwrap_or(f64::NAN));
+            header.iter().map(|h| h.to_string()).zip(cells).collect()
+        })
+        .collect()
+}
+
+/// The `xr_report.json` of a `method` session in `out` and its frame log, checked to
+/// agree: one row per display frame, the rows' body frames summing to the report's.
+fn xr_session(out: &Path, method: &str) -> (serde_json::Value, Vec<HashMap<String, f64>>) {
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("xr_report.json")).unwrap()).unwrap();
+    assert_eq!(r["method"], method, "{r}");
+    let rows = frame_rows(out);
+    assert_eq!(rows.len() as u64, r["frames"].as_u64().unwrap(), "{r}");
+    let rendered = rows.iter().filter(|f| f["rendered"] == 1.0).count();
+    assert_eq!(rendered as u64, r["rendered"].as_u64().unwrap(), "{r}");
+    let stepped: f64 = rows.iter().map(|f| f["sim_frames"]).sum();
+    assert_eq!(stepped, r["sim_frames"].as_f64().unwrap(), "{r}");
+    assert!(stepped > 0.0, "{r}");
+    (r, rows)
 }
 
 #[test]
@@ -193,6 +224,7 @@ fn xpbd_headset_releases_tets() {
     let r: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("xr_report.json")).unwrap()).unwrap();
     assert!(r["released_tets"].as_u64().unwrap() > 20, "{stdout}");
+    assert_eq!(r["method"], "xpbd", "{r}");
 }
 
 #[test]
@@ -216,6 +248,19 @@ fn nakao_headset_cuts_by_its_stroke_and_by_the_controller_with_its_own_force() {
     );
     assert!(r["nakao"]["opening_width_m"].as_f64().unwrap() > 5e-4);
     assert!(scripted.join("eye_left_00024.png").exists());
+    // Its frame log and xr_report.json, as an XPBD session's: nobody holds the trigger or
+    // the tool, so nothing vibrates.
+    let (x, rows) = xr_session(&scripted, "nakao");
+    assert!(
+        rows.iter()
+            .all(|f| f["engaged"] == 0.0 && f["haptic"] == 0.0)
+    );
+    assert_eq!(x["haptic_pulses"], 0, "{x}");
+    assert_eq!(x["exit"], "Exited", "{x}");
+    assert!(
+        x["released_tets"].is_null() && x["substeps"].is_null(),
+        "{x}"
+    );
     // The right controller draws a 10 cm incision 4 mm deep with the trigger held.
     let hand = dir.join("hand");
     let right = "right: Some(Tool(start: 0.1, stroke: Incision((start: (-0.05, 0.0, 0.002),
@@ -237,6 +282,50 @@ fn nakao_headset_cuts_by_its_stroke_and_by_the_controller_with_its_own_force() {
     // controller vibrates with that force.
     let pulses = number_after(&stdout, "rendered), ");
     assert!(pulses > 10.0, "{stdout}");
+    // Each display frame logs the coupling force and the vibration it sent: the blade
+    // (x −5 → 5 cm at 0.1 m/s from 0.1 s) is in the plate for most of the session.
+    let (x, rows) = xr_session(&hand, "nakao");
+    assert_eq!(x["haptic_pulses"].as_f64().unwrap(), pulses, "{x}");
+    let vibrated = rows.iter().filter(|f| f["haptic"] > 0.0).count();
+    assert_eq!(vibrated as f64, pulses, "{x}");
+    let cutting = rows
+        .iter()
+        .filter(|f| f["engaged"] == 1.0 && f["tool_force_n"] > 0.05)
+        .count();
+    assert!(
+        cutting * 2 > rows.len(),
+        "{cutting} of {} frames",
+        rows.len()
+    );
+    let max = rows.iter().map(|f| f["tool_force_n"]).fold(0.0, f64::max);
+    let reported = x["max_tool_force"].as_f64().unwrap();
+    assert!(max > 0.05 && (max - reported).abs() < 1e-3, "{max} vs {x}");
+}
+
+/// A Nakao session whose runtime fails 0.3 s in exits 1 and keeps its frame log and
+/// `xr_report.json` up to the failure, as an XPBD session does.
+#[test]
+fn a_failed_nakao_session_keeps_its_frame_log_and_xr_report() {
+    let dir = temp_dir("mh-nakao-fault");
+    let script = script(&dir, 0.6, "faults: [(0.3, RuntimeFailure)],");
+    let out = dir.join("out");
+    let o = run_xr("config/plate_cut_nakao.ron", &script, &out, &[]);
+    if no_adapter(&o) {
+        return;
+    }
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("ERROR_RUNTIME_FAILURE") && err.contains("were kept"),
+        "{err}"
+    );
+    let (x, _) = xr_session(&out, "nakao");
+    assert!(x["exit"].as_str().unwrap().starts_with("failed: "), "{x}");
+    let frames = x["frames"].as_u64().unwrap();
+    assert!(
+        (18..=26).contains(&frames),
+        "{frames} frames before the fault"
+    );
 }
 
 /// `incise xr` on the Nakao plate with a real-time simulated headset and every body
@@ -246,18 +335,8 @@ fn slowed_realtime_headset(dir: &Path, mode: &str) -> Option<String> {
     let written = std::fs::read_to_string(self::script(dir, 0.8, "realtime: true,")).unwrap();
     std::fs::write(&script, written).unwrap();
     let out = dir.join(mode);
-    let o = incise(&[
-        "xr",
-        "config/plate_cut_nakao.ron",
-        "--simulated-headset",
-        script.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--sim",
-        mode,
-        "--slow-sim-ms",
-        "40",
-    ]);
+    let slow = ["--sim", mode, "--slow-sim-ms", "40"];
+    let o = run_xr("config/plate_cut_nakao.ron", &script, &out, &slow);
     if no_adapter(&o) {
         return None;
     }
@@ -311,6 +390,14 @@ fn rheology_headset_presses_and_creeps_back() {
         end > 1e-4 && end < 0.8 * max,
         "crept back to {end} m from {max} m"
     );
+    // The indenter is driven by displacement: the body has no tool force to vibrate with.
+    let (x, rows) = xr_session(&out, "rheology");
+    assert_eq!(x["max_tool_force"], 0.0, "{x}");
+    assert!(
+        rows.iter()
+            .all(|f| f["tool_force_n"] == 0.0 && f["haptic"] == 0.0)
+    );
+    assert_eq!(x["solver_device"], "cpu (rheology)", "{x}");
 }
 
 /// The scene files shipped in config/ (the `.ron` files that are scenes, not presets).

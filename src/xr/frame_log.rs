@@ -13,11 +13,12 @@ pub struct FrameRow {
     pub frame: u64,
     /// Predicted display time, s (from the session's start).
     pub display_time: f64,
-    /// Simulation frames stepped.
+    /// Simulation frames completed since the previous display frame (another method than
+    /// XPBD: its body's frames).
     pub sim_frames: u32,
-    /// Substeps per simulation frame.
+    /// Substeps per simulation frame (another method: 1, one body step a frame).
     pub substeps: u32,
-    /// Wall time of the simulation, ms.
+    /// Wall time of the simulation, ms (on a thread: of its latest frame's step).
     pub sim_ms: f64,
     /// Wall time of recording the frame's rendering (prepare, draw, submit), ms.
     pub render_ms: f64,
@@ -25,9 +26,11 @@ pub struct FrameRow {
     pub frame_ms: f64,
     /// Whether the eyes were rendered.
     pub rendered: bool,
-    /// Blade engaged (trigger).
+    /// Blade engaged: the trigger held, or (XPBD) a played stroke; another method's scene
+    /// script cuts or presses without it.
     pub engaged: bool,
-    /// Tool contact force, N.
+    /// Tool contact force, N (another method: the force of its own tool, scripted or the
+    /// controller's).
     pub tool_force: f32,
     /// Vibration amplitude sent, 0..1.
     pub haptic: f32,

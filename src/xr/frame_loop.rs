@@ -74,17 +74,8 @@ pub struct LoopOutcome {
     pub cut_box: Option<super::xr_body::CutBox>,
     /// Largest tool contact force, N.
     pub max_tool_force: f32,
-    /// Largest vibration amplitude sent.
-    pub max_haptic: f32,
     /// Simulated time given up to keep real time, s.
     pub dropped_time: f64,
-    /// Display refreshes the session's frames missed because a frame came late: the
-    /// predicted display times of consecutive frames are this many nominal display
-    /// periods more than one apart (a runtime may also stretch the period it predicts
-    /// for a slow app; the nominal period is the shortest it predicted).
-    pub dropped_frames: u64,
-    /// The nominal display rate: the highest the runtime predicted, Hz.
-    pub display_hz: f64,
     /// Wall time of the session loop, s.
     pub wall_s: f64,
     /// Wall time the simulation ran, s (the thread: from the first command).
@@ -122,10 +113,7 @@ impl LoopOutcome {
             released_tets: 0,
             cut_box: None,
             max_tool_force: 0.0,
-            max_haptic: 0.0,
             dropped_time: 0.0,
-            dropped_frames: 0,
-            display_hz: 0.0,
             wall_s: 0.0,
             sim_wall_s: 0.0,
             min_substeps_used: nominal_substeps,
@@ -382,7 +370,6 @@ impl<'o> Display<'_, 'o> {
             HapticCall::Nothing => {}
         }
         let sent = pulse.map_or(0.0, |p| p.amplitude);
-        self.out.max_haptic = self.out.max_haptic.max(sent);
         Ok(sent)
     }
 
@@ -512,7 +499,6 @@ impl<'o> Display<'_, 'o> {
             haptics,
             ..
         } = self;
-        (out.display_hz, out.dropped_frames) = out.log.missed_refreshes();
         // An attempt the blade touched is scored and saved however the session ended.
         let saved = match exercise {
             Some(ex) => ex.end_session(xr),

@@ -6,7 +6,8 @@
 //! right controller's trigger takes the tool: then the scalpel cuts (Nakao) or presses
 //! (rheology) where the controller holds it, vibrating with the method's tool force where
 //! it has one. Both eyes show the heat map of the method's own quantity. Writes the body's
-//! `report.json` (the run's schema) into the output folder.
+//! `report.json` (the run's schema) into the output folder, and the session's frame log
+//! (`frames.csv`) and `xr_report.json` as an XPBD session does (also when it fails).
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -14,20 +15,21 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use incise_scalpel::HapticCurve;
 use incise_xr::openxr::haptics::haptic_pulse;
+use incise_xr::openxr::lifecycle::ExitReason;
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
 use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, eye::eye_view};
 use incise_xr::{Overlays, RenderDevice, RenderSettings, Renderer};
 
-use super::method_thread::{MethodCommand, MethodThread};
+use super::frame_log::{FrameLog, FrameRow};
+use super::method_stepper::Stepper;
 use super::script::{HeadsetScript, RightTrack};
 use super::sim_mode::{self, SimChoice, SimMode};
-use super::sim_thread::MAX_CATCH_UP;
 use super::simulated::SimulatedHeadset;
+use super::xr_report::{self, XrReport};
 use crate::bench::soak::percentile;
 use crate::pictures::tet_drawing::TetDrawing;
 use crate::sim_body::ToolInput;
-use crate::sim_body::recorded::RecordedBody;
 
 /// Where a method session steps its body, and a slowdown per body frame (testing aid).
 #[derive(Debug, Clone)]
@@ -40,14 +42,6 @@ pub struct MethodSim {
     pub frames: Option<u64>,
 }
 
-/// The body of a session: stepped inside the display frame, or on its own thread.
-enum Stepper {
-    /// In the frame: the display waits for the steps.
-    InFrame(Box<RecordedBody>, Duration),
-    /// On a thread; the display draws its newest frame (`shown`: its frame count).
-    Thread(MethodThread, usize),
-}
-
 /// What a method session did.
 struct Session {
     stepper: Stepper,
@@ -58,18 +52,22 @@ struct Session {
     hand: bool,
     /// The display time of the first frame, s (simulated time 0).
     start: Option<f64>,
-    frames: u64,
-    rendered: u64,
+    /// Vibration pulses sent.
     pulses: u64,
+    /// Vibration stops sent (every display frame without a pulse).
+    stops: u64,
     haptic: HapticCurve,
-    /// Wall time of each display frame's work (stepping, vibration, drawing), ms.
-    frame_ms: Vec<f64>,
+    /// One row per display frame.
+    log: FrameLog,
     /// Simulated time given up by an in-frame body slower than real time, s.
     given_up: f64,
+    /// Why the runtime ended the session, once it has.
+    exit: Option<ExitReason>,
 }
 
 /// Run `scene` (any method but XPBD) on the simulated headset playing `script_path`,
-/// writing eye images and `report.json` to `out`; the session's summary line.
+/// writing eye images, `report.json`, `frames.csv` and `xr_report.json` to `out`; the
+/// session's summary line.
 pub fn run_simulated(
     scene: &Path,
     script_path: &Path,
@@ -79,7 +77,7 @@ pub fn run_simulated(
     let script = HeadsetScript::load(script_path)?;
     let (mode, why) = sim_mode::resolve(sim.choice, false, !script.realtime)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let (stepper, drawing) = open_stepper(scene, out, mode, sim.slow)?;
+    let (stepper, drawing) = Stepper::open(scene, out, mode, sim.slow)?;
     let tray = tray_for(&drawing);
     let stroke = tool_stroke(&script, script_path)?;
     let dev = RenderDevice::headless()?;
@@ -92,13 +90,13 @@ pub fn run_simulated(
         tray,
         out,
         (mode, why),
-        sim.frames,
+        sim,
     )
 }
 
 /// Run `scene` (any method but XPBD) on the runtime's `headset` (real time: the body on
-/// its own thread unless `sim` says otherwise), writing `report.json` to `out`; the
-/// session's summary line.
+/// its own thread unless `sim` says otherwise), writing `report.json`, `frames.csv` and
+/// `xr_report.json` to `out`; the session's summary line.
 pub fn run_on_runtime(
     headset: &mut dyn Headset,
     scene: &Path,
@@ -107,33 +105,9 @@ pub fn run_on_runtime(
 ) -> Result<String> {
     let (mode, why) = sim_mode::resolve(sim.choice, false, false)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let opened = open_stepper(scene, out, mode, sim.slow)?;
+    let opened = Stepper::open(scene, out, mode, sim.slow)?;
     let tray = tray_for(&opened.1);
-    run_on(headset, scene, opened, tray, out, (mode, why), sim.frames)
-}
-
-/// Open `scene`'s body as `mode` says (slowed by `slow` a frame), writing its report to
-/// `out` at the end; the body and its first drawing.
-fn open_stepper(
-    scene: &Path,
-    out: &Path,
-    mode: SimMode,
-    slow: Duration,
-) -> Result<(Stepper, TetDrawing)> {
-    let (stepper, view) = match mode {
-        SimMode::InFrame => {
-            let body = RecordedBody::open(scene)?;
-            let view = body.body.tet_view();
-            (Stepper::InFrame(Box::new(body), slow), view)
-        }
-        SimMode::Thread => {
-            let mut t = MethodThread::spawn(scene, out.join("report.json"), slow)?;
-            let first = t.latest()?;
-            (Stepper::Thread(t, first.frames), first.view.clone())
-        }
-    };
-    let drawing = TetDrawing::new(view).with_context(|| format!("{}: drawing", scene.display()))?;
-    Ok((stepper, drawing))
+    run_on(headset, scene, opened, tray, out, (mode, why), sim)
 }
 
 /// The tray that holds the body of `drawing`.
@@ -142,10 +116,11 @@ fn tray_for(drawing: &TetDrawing) -> Tray {
     Tray::for_bounds(lo, hi)
 }
 
-/// Run the opened body of `scene` (from [`open_stepper`]) on `headset` with the organ on
-/// `tray` (ending it after `max_frames` display frames, if given); `report.json` written
-/// to `out`; the session's summary line, saying where the body was stepped (`mode`, and
-/// why) and what a display frame cost.
+/// Run the opened body of `scene` (from [`Stepper::open`]) on `headset` with the organ on
+/// `tray` (ending it after `sim.frames` display frames, if given); the body's
+/// `report.json`, `frames.csv` and `xr_report.json` written to `out` (the last two also
+/// when the session fails); the session's summary line, saying where the body was
+/// stepped (`mode`, and why) and what a display frame cost.
 fn run_on(
     headset: &mut dyn Headset,
     scene: &Path,
@@ -153,7 +128,7 @@ fn run_on(
     tray: Tray,
     out: &Path,
     (mode, why): (SimMode, String),
-    max_frames: Option<u64>,
+    sim: &MethodSim,
 ) -> Result<String> {
     let dev = headset.device().clone();
     let renderer = renderer_for(&dev, headset.format(), &drawing);
@@ -164,48 +139,29 @@ fn run_on(
         tray,
         hand: false,
         start: None,
-        frames: 0,
-        rendered: 0,
         pulses: 0,
+        stops: 0,
         haptic: HapticCurve::default(),
-        frame_ms: Vec::new(),
+        log: FrameLog::default(),
         given_up: 0.0,
+        exit: None,
     };
-    let mut exit_asked = false;
-    while let Some(frame) = next(headset)? {
-        let t0 = Instant::now();
-        s.frame(headset, &dev, &frame)?;
-        s.frame_ms.push(t0.elapsed().as_secs_f64() * 1e3);
-        if !exit_asked && max_frames.is_some_and(|m| s.frames >= m) {
-            headset.request_exit()?;
-            exit_asked = true;
-        }
-    }
-    let (frames, rendered, pulses) = (s.frames, s.rendered, s.pulses);
-    s.frame_ms.sort_by(f64::total_cmp);
-    let (p50, p95) = (percentile(&s.frame_ms, 0.5), percentile(&s.frame_ms, 0.95));
-    let summary = match s.stepper {
-        Stepper::InFrame(body, _) => body.close(Some(&out.join("report.json")))?,
-        Stepper::Thread(thread, _) => thread.finish()?,
-    };
+    let started = Instant::now();
+    let ended = s.run(headset, &dev, sim.frames);
+    let wall_s = started.elapsed().as_secs_f64();
+    let report = s.report(headset, scene, (mode, why.clone()), sim.slow)?;
+    let (p50, p95) = s.work_p50_p95();
+    let (report, summary) = s.close(ended, report, wall_s, out)?;
     Ok(format!(
-        "{} on {}: {frames} display frames ({rendered} rendered), {pulses} vibration pulses, \
+        "{} on {}: {} display frames ({} rendered), {} vibration pulses, \
          body stepped {} ({why}), display frame work p50 {p50:.2} ms, p95 {p95:.2} ms; {summary}",
         scene.display(),
-        headset.describe(),
+        report.headset,
+        report.frames,
+        report.rendered,
+        report.haptic_pulses,
         mode.name(),
     ))
-}
-
-/// The next begun frame, `None` when the session has ended.
-fn next(headset: &mut dyn Headset) -> Result<Option<HeadsetFrame>> {
-    loop {
-        match headset.next_frame()? {
-            FrameEvent::Frame(f) => return Ok(Some(*f)),
-            FrameEvent::Idle => continue,
-            FrameEvent::Ended(_) => return Ok(None),
-        }
-    }
 }
 
 /// The scripted right-hand stroke, drawn with the built-in scalpel.
@@ -224,29 +180,171 @@ fn tool_stroke(script: &HeadsetScript, path: &Path) -> Result<Option<incise_scal
 }
 
 impl Session {
+    /// Display frames until the session ends, asking the runtime to end it after
+    /// `max_frames`.
+    fn run(
+        &mut self,
+        headset: &mut dyn Headset,
+        dev: &RenderDevice,
+        max_frames: Option<u64>,
+    ) -> Result<()> {
+        let mut exit_asked = false;
+        while let Some(frame) = self.next(headset)? {
+            self.frame(headset, dev, &frame)?;
+            if !exit_asked && max_frames.is_some_and(|m| self.log.rows.len() as u64 >= m) {
+                headset.request_exit()?;
+                exit_asked = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// The next begun frame, `None` when the session has ended (the runtime's reason kept).
+    fn next(&mut self, headset: &mut dyn Headset) -> Result<Option<HeadsetFrame>> {
+        loop {
+            match headset.next_frame()? {
+                FrameEvent::Frame(f) => return Ok(Some(*f)),
+                FrameEvent::Idle => continue,
+                FrameEvent::Ended(why) => {
+                    self.exit = Some(why);
+                    return Ok(None);
+                }
+            }
+        }
+    }
+
+    /// Close the body after the session `ended` (its `report.json` written unless the
+    /// session failed), then write `frames.csv` and `report` (completed with the body
+    /// frames stepped, their rate over `wall_s` and how the session ended) into `out`,
+    /// also on a failure; the report and the body's summary line.
+    fn close(
+        self,
+        ended: Result<()>,
+        mut report: XrReport,
+        wall_s: f64,
+        out: &Path,
+    ) -> Result<(XrReport, String)> {
+        let closed = ended.and_then(|()| self.stepper.close(out));
+        if let Ok((_, frames)) = &closed {
+            report.sim_frames = *frames as u64;
+        }
+        if wall_s > 0.0 {
+            report.sim_steps_per_s = report.sim_frames as f64 / wall_s;
+        }
+        report.exit = xr_report::exit_text(closed.as_ref().err(), false, self.exit);
+        report.save(&self.log, out)?;
+        let kept = "the frame log and xr_report.json";
+        match closed {
+            Ok((summary, _)) => Ok((report, summary)),
+            Err(e) => Err(xr_report::failed(e, report.frames, kept, out)),
+        }
+    }
+
+    /// Median and 95th percentile of the display frames' own work (stepping, vibration,
+    /// drawing), ms.
+    fn work_p50_p95(&self) -> (f64, f64) {
+        let mut ms: Vec<f64> = self.log.rows.iter().map(|r| r.frame_ms).collect();
+        ms.sort_by(f64::total_cmp);
+        (percentile(&ms, 0.5), percentile(&ms, 0.95))
+    }
+
+    /// The session's `xr_report.json` so far: `scene` on `headset`, stepped `mode` (why),
+    /// each body frame slowed by `slow`, the frames stepped as many as published.
+    fn report(
+        &self,
+        headset: &dyn Headset,
+        scene: &Path,
+        (mode, why): (SimMode, String),
+        slow: Duration,
+    ) -> Result<XrReport> {
+        let (method, solver_device) = self.stepper.body()?;
+        let rows = &self.log.rows;
+        Ok(XrReport {
+            scene: scene.display().to_string(),
+            solver_device,
+            sim_mode: mode.name().into(),
+            sim_mode_why: why,
+            sim_frames: self.stepper.frames() as u64,
+            max_tool_force: rows.iter().map(|r| r.tool_force).fold(0.0, f32::max),
+            haptic_pulses: self.pulses,
+            haptic_stops: self.stops,
+            dropped_time_s: self.given_up,
+            slow_sim_ms: slow.as_millis() as u64,
+            ..XrReport::new(method, &self.log, headset)
+        })
+    }
+
     /// One display frame: step the body up to the frame's display time with the tool,
-    /// vibrate, draw both eyes.
+    /// vibrate, draw both eyes, log the frame's row (also when ending the frame failed).
     fn frame(
         &mut self,
         headset: &mut dyn Headset,
         dev: &RenderDevice,
         f: &HeadsetFrame,
     ) -> Result<()> {
-        self.frames += 1;
+        let started = Instant::now();
         let start = *self.start.get_or_insert(f.display_time);
         let tool = self.tool(f);
-        let (force, changed) = self.advance(tool, f.display_time - start - self.given_up)?;
-        if changed {
+        let stamp = (self.log.rows.len() as u64, f.display_time);
+        let until = f.display_time - start - self.given_up;
+        let step = self.stepper.advance(tool, until, stamp)?;
+        self.given_up += step.given_up;
+        if let Some(view) = step.view
+            && self.drawing.update(view)?
+        {
+            // The topology changed.
             self.renderer = renderer_for(dev, headset.format(), &self.drawing);
         }
-        let pulse = haptic_pulse(self.haptic.amplitude(force), self.hand, f.display_period);
-        if pulse.is_some() {
-            self.pulses += 1;
+        let adv = step.done;
+        let haptic = self.vibrate(headset, adv.tool_force, f.display_period)?;
+        let render_start = Instant::now();
+        // A frame the runtime fails to end is still logged: its body frames were stepped.
+        let ended = if f.should_render {
+            self.render(headset, dev, f)
+        } else {
+            headset.end_frame(false).map_err(anyhow::Error::from)
+        };
+        let rendered = f.should_render && ended.is_ok();
+        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+        self.log.rows.push(FrameRow {
+            frame: stamp.0,
+            display_time: f.display_time,
+            sim_frames: adv.sim_frames,
+            substeps: adv.substeps,
+            sim_ms: adv.sim_ms,
+            render_ms: ms(render_start),
+            frame_ms: ms(started),
+            rendered,
+            engaged: f.controllers.blade_engaged(),
+            tool_force: adv.tool_force,
+            haptic,
+            display_period: f.display_period,
+            tool_latency_ms: (self.stepper.last_command())
+                .filter(|_| rendered)
+                .map(|(_, t)| (f.display_time - t) * 1e3),
+        });
+        ended
+    }
+
+    /// Vibrate with the tool force `force`, N, while the controller holds the tool; the
+    /// amplitude sent.
+    fn vibrate(&mut self, headset: &mut dyn Headset, force: f32, period: f64) -> Result<f32> {
+        let pulse = haptic_pulse(self.haptic.amplitude(force), self.hand, period);
+        match pulse {
+            Some(_) => self.pulses += 1,
+            None => self.stops += 1,
         }
         headset.vibrate(pulse)?;
-        if !f.should_render {
-            return Ok(headset.end_frame(false)?);
-        }
+        Ok(pulse.map_or(0.0, |p| p.amplitude))
+    }
+
+    /// Both eyes, drawn from the body's newest frame.
+    fn render(
+        &mut self,
+        headset: &mut dyn Headset,
+        dev: &RenderDevice,
+        f: &HeadsetFrame,
+    ) -> Result<()> {
         let targets = headset.acquire()?;
         let stage_from_sim = self.tray.stage_from_sim();
         let views = f
@@ -276,46 +374,7 @@ impl Session {
             headset.eye_size(),
         );
         dev.queue.submit([enc.finish()]);
-        headset.end_frame(true)?;
-        self.rendered += 1;
-        Ok(())
-    }
-
-    /// Step the body in the frame, or hand its thread the frame's command, up to
-    /// simulated time `until` with `tool`; the force on the tool, N, and whether the
-    /// drawing's topology changed.
-    fn advance(&mut self, tool: ToolInput, until: f64) -> Result<(f32, bool)> {
-        let (view, force) = match &mut self.stepper {
-            Stepper::InFrame(body, slow) => {
-                let dt = body.body.frame_dt();
-                let mut stepped = 0;
-                while body.body.time() + 0.5 * dt < until && stepped < MAX_CATCH_UP {
-                    body.step(&tool).map_err(anyhow::Error::msg)?;
-                    std::thread::sleep(*slow);
-                    stepped += 1;
-                }
-                // A body slower than real time gives the owed time up rather than hold
-                // every later display frame (as the XPBD frame pacer does).
-                let owed = until - body.body.time() - 0.5 * dt;
-                if owed > 0.0 {
-                    self.given_up += owed;
-                }
-                let force = body.body.tool_force().map_or(0.0, |v| v.length());
-                ((stepped > 0).then(|| body.body.tet_view()), force)
-            }
-            Stepper::Thread(thread, shown) => {
-                thread.post(MethodCommand { tool, until });
-                let s = thread.latest()?;
-                let fresh = s.frames != *shown;
-                *shown = s.frames;
-                (fresh.then(|| s.view.clone()), s.force)
-            }
-        };
-        let changed = match view {
-            Some(v) => self.drawing.update(v)?,
-            None => false,
-        };
-        Ok((force, changed))
+        Ok(headset.end_frame(true)?)
     }
 
     /// The frame's tool: the scene's script until the trigger engages the controller's.

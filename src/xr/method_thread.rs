@@ -7,16 +7,17 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
 
 use super::latest::Latest;
+use super::sim_state::CommandStamp;
 use crate::sim_body::recorded::RecordedBody;
-use crate::sim_body::{TetView, ToolInput};
+use crate::sim_body::{Method, TetView, ToolInput};
 
 /// How long the thread sleeps when it has caught up with the display.
 const IDLE: Duration = Duration::from_millis(1);
@@ -28,6 +29,8 @@ pub struct MethodCommand {
     pub tool: ToolInput,
     /// Step while the body is more than half a frame behind this time.
     pub until: f64,
+    /// The display frame that sampled the tool, and its predicted display time, s.
+    pub stamp: CommandStamp,
 }
 
 /// A completed simulation frame, as the display draws it.
@@ -38,12 +41,18 @@ pub struct MethodState {
     pub force: f32,
     /// Frames stepped so far.
     pub frames: usize,
+    /// Wall time of the frame's step, ms (0 before the first).
+    pub step_ms: f64,
+    /// The newest command the body was stepped with (`None`: not stepped yet).
+    pub command: Option<CommandStamp>,
 }
 
 #[derive(Default)]
 struct Link {
     commands: Latest<MethodCommand>,
     states: Latest<MethodState>,
+    /// The body's method and where it runs, once open.
+    body: OnceLock<(Method, String)>,
     stop: AtomicBool,
 }
 
@@ -97,10 +106,27 @@ impl MethodThread {
             .ok_or_else(|| anyhow!("the simulation thread published no frame"))
     }
 
-    /// Stop the thread; the report's summary line (the report written).
-    pub fn finish(mut self) -> Result<String> {
+    /// Stop the thread; the report's summary line (the report written) and the frames
+    /// the body stepped.
+    pub fn finish(mut self) -> Result<(String, usize)> {
         self.link.stop.store(true, Ordering::Release);
-        self.join()
+        let summary = self.join()?;
+        Ok((summary, self.frames()))
+    }
+
+    /// The body's method and where it runs ([`crate::sim_body::SimBody::device`]), named
+    /// by the thread before its first frame.
+    pub fn body(&self) -> Result<(Method, String)> {
+        self.link
+            .body
+            .get()
+            .cloned()
+            .ok_or_else(|| anyhow!("the simulation thread has not opened its body"))
+    }
+
+    /// Frames the body has stepped so far (as published).
+    pub fn frames(&self) -> usize {
+        self.link.states.get().map_or(0, |s| s.frames)
     }
 
     fn join(&mut self) -> Result<String> {
@@ -126,7 +152,8 @@ impl Drop for MethodThread {
 /// The thread: open, publish, then step to each command's time until stopped.
 fn run(scene: &Path, report: &Path, slow: Duration, link: &Link) -> Result<String> {
     let mut sim = RecordedBody::open(scene)?;
-    publish(&sim, link);
+    let _ = link.body.set((sim.body.method(), sim.body.device()));
+    publish(&sim, link, 0.0, None);
     let dt = sim.body.frame_dt();
     while !link.stop.load(Ordering::Acquire) {
         let behind = link
@@ -137,18 +164,22 @@ fn run(scene: &Path, report: &Path, slow: Duration, link: &Link) -> Result<Strin
             std::thread::sleep(IDLE);
             continue;
         };
+        let t0 = Instant::now();
         sim.step(&cmd.tool).map_err(anyhow::Error::msg)?;
+        let step_ms = t0.elapsed().as_secs_f64() * 1e3;
         std::thread::sleep(slow);
-        publish(&sim, link);
+        publish(&sim, link, step_ms, Some(cmd.stamp));
     }
     sim.close(Some(report))
 }
 
-/// Publish the body's current frame.
-fn publish(sim: &RecordedBody, link: &Link) {
+/// Publish the body's current frame, stepped in `step_ms` with `command`.
+fn publish(sim: &RecordedBody, link: &Link, step_ms: f64, command: Option<CommandStamp>) {
     link.states.put(MethodState {
         view: sim.body.tet_view(),
         force: sim.body.tool_force().map_or(0.0, |f| f.length()),
         frames: sim.frames(),
+        step_ms,
+        command,
     });
 }

@@ -8,6 +8,7 @@ pub mod frame_loop;
 pub mod in_frame;
 pub mod latest;
 pub mod method_session;
+pub mod method_stepper;
 pub mod method_thread;
 pub mod script;
 pub mod sim_mode;
@@ -18,6 +19,7 @@ pub mod sim_thread;
 pub mod simulated;
 pub mod unavailable;
 pub mod xr_body;
+pub mod xr_report;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -28,10 +30,9 @@ use incise_xr::RenderDevice;
 use incise_xr::openxr::scalpel_pose::BladeOffset;
 use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{Headset, XrSession};
-use serde::Serialize;
 
-use crate::sim_body::DeviceChoice;
-use exercise::{AttemptSummary, XrExercise};
+use crate::sim_body::{DeviceChoice, Method};
+use exercise::XrExercise;
 use frame_loop::{LoopOptions, LoopOutcome, run_loop};
 use script::{HeadsetScript, Pacing, RightTrack};
 use sim_mode::{SimChoice, SimMode};
@@ -39,6 +40,7 @@ use sim_step::SimFaults;
 use simulated::SimulatedHeadset;
 pub use unavailable::XrUnavailable;
 use xr_body::XrBody;
+pub use xr_report::XrReport;
 
 /// What `incise xr` was asked.
 #[derive(Debug, Clone)]
@@ -73,76 +75,6 @@ pub struct XrOptions {
     pub slow_sim_ms: u64,
     /// Testing aid: a panic in the simulation just before this simulation frame.
     pub inject_sim_panic_at: Option<u64>,
-}
-
-/// The session summary written as `xr_report.json`.
-#[derive(Debug, Serialize)]
-pub struct XrReport {
-    /// Scene file.
-    pub scene: String,
-    /// The headset (runtime name or "simulated …") and render device.
-    pub headset: String,
-    /// Solver device.
-    pub solver_device: String,
-    /// Where the solver was stepped: "thread" (its own thread, paced to real time; each
-    /// display frame renders its latest completed state) or "in-frame" (inside each
-    /// display frame, which waits for it).
-    pub sim_mode: String,
-    /// Why that mode.
-    pub sim_mode_why: String,
-    /// Display frames (begun by the runtime's frame loop).
-    pub frames: u64,
-    /// Display frames rendered (ended with a projection layer).
-    pub rendered: u64,
-    /// Simulation frames stepped.
-    pub sim_frames: u64,
-    /// The session states the runtime reported, in order (IDLE first).
-    pub session_states: Vec<String>,
-    /// Released tets at the end.
-    pub released_tets: usize,
-    /// Where the cut is: the bounding box (min, max, sim world, m) of the released tets'
-    /// rest centroids.
-    pub cut_box: Option<xr_body::CutBox>,
-    /// Largest tool force, N.
-    pub max_tool_force: f32,
-    /// Largest vibration amplitude.
-    pub max_haptic: f32,
-    /// Vibration pulses sent.
-    pub haptic_pulses: u64,
-    /// Vibration stops sent (once each time the blade left the tissue).
-    pub haptic_stops: u64,
-    /// Simulated time given up, s.
-    pub dropped_time_s: f64,
-    /// The display rate the runtime reported, Hz.
-    pub display_hz: f64,
-    /// Display frames the runtime skipped because a frame came late.
-    pub dropped_frames: u64,
-    /// Simulation frames stepped per second of wall time (over the simulation's wall
-    /// time: the thread's, from its first command; in the frame, the session's).
-    pub sim_steps_per_s: f64,
-    /// Tool-to-tissue latency, median and 95th percentile over rendered frames, ms: a
-    /// frame's predicted display time minus that of the frame whose tool pose (sampled
-    /// for its predicted display time) was the newest the tissue it shows was stepped
-    /// with (`frames.csv`: tool_latency_ms).
-    pub tool_latency_ms_p50_p95: Option<(f64, f64)>,
-    /// The testing aid's sleep per simulation frame, ms (0: none).
-    pub slow_sim_ms: u64,
-    /// Scene substeps and the fewest used.
-    pub substeps: (u32, u32),
-    /// Median and 95th-percentile wall time of rendered frames, ms.
-    pub frame_ms_p50_p95: Option<(f64, f64)>,
-    /// Times the solver failed (an inverted tet) and the scene was reset.
-    pub solver_resets: u32,
-    /// How the session ended.
-    pub exit: String,
-    /// The recorded stroke, if any.
-    pub stroke: Option<String>,
-    /// The stroke file that drove the scalpel (`--stroke`), if any.
-    pub played_stroke: Option<String>,
-    /// The exercise file, in an exercise session.
-    pub exercise: Option<String>,
-    /// The exercise attempts finished and saved in the session.
-    pub attempts: Vec<AttemptSummary>,
 }
 
 /// Run `incise xr`; the session's summary line. A scene of another method than XPBD runs
@@ -296,8 +228,7 @@ fn run_session(
             incise_scalpel::load_stroke(p).with_context(|| format!("--stroke {}", p.display()))
         })
         .transpose()?;
-    let describe = headset.describe();
-    eprintln!("xr: {describe}");
+    eprintln!("xr: {}", headset.describe());
     eprintln!("xr: simulation {} ({sim_mode_why})", sim_mode.name());
     let mut outcome: LoopOutcome = run_loop(
         headset,
@@ -322,7 +253,6 @@ fn run_session(
         },
         exercise.as_deref_mut(),
     )?;
-    outcome.log.save(&opts.out.join("frames.csv"))?;
     let mut stroke_path = None;
     if let Some(stroke) = &outcome.stroke {
         let p = opts.out.join("stroke.ron");
@@ -332,62 +262,41 @@ fn run_session(
         }
         stroke_path = Some(p.display().to_string());
     }
-    let quant = |q| outcome.log.frame_ms_quantile(q);
-    let latency = |q| outcome.log.latency_ms_quantile(q);
     let report = XrReport {
         scene: xr.scene_path().display().to_string(),
-        headset: describe,
         solver_device: xr.body.device(),
         sim_mode: sim_mode.name().into(),
         sim_mode_why,
-        frames: outcome.frames,
-        rendered: outcome.rendered,
         sim_frames: outcome.sim_frames,
-        session_states: outcome
-            .session_states
-            .iter()
-            .map(|p| format!("{p:?}"))
-            .collect(),
-        released_tets: outcome.released_tets,
+        released_tets: Some(outcome.released_tets),
         cut_box: outcome.cut_box,
         max_tool_force: outcome.max_tool_force,
-        max_haptic: outcome.max_haptic,
         haptic_pulses: outcome.haptic_pulses,
         haptic_stops: outcome.haptic_stops,
         dropped_time_s: outcome.dropped_time,
-        display_hz: outcome.display_hz,
-        dropped_frames: outcome.dropped_frames,
         sim_steps_per_s: if outcome.sim_wall_s > 0.0 {
             outcome.sim_frames as f64 / outcome.sim_wall_s
         } else {
             0.0
         },
-        tool_latency_ms_p50_p95: latency(0.5).zip(latency(0.95)),
         slow_sim_ms: opts.slow_sim_ms,
-        substeps: (xr.nominal_substeps(), outcome.min_substeps_used),
-        frame_ms_p50_p95: quant(0.5).zip(quant(0.95)),
-        solver_resets: outcome.solver_resets,
-        exit: match (&outcome.error, outcome.exit) {
-            (Some(e), _) => format!("failed: {e:#}"),
-            (None, _) if outcome.interrupted => "Interrupted".into(),
-            (None, Some(e)) => format!("{e:?}"),
-            (None, None) => "the runtime never made the session ready".into(),
-        },
+        substeps: Some((xr.nominal_substeps(), outcome.min_substeps_used)),
+        solver_resets: Some(outcome.solver_resets),
+        exit: xr_report::exit_text(outcome.error.as_ref(), outcome.interrupted, outcome.exit),
         stroke: stroke_path,
         played_stroke: opts.stroke.as_ref().map(|p| p.display().to_string()),
         exercise: opts.exercise.as_ref().map(|p| p.display().to_string()),
         attempts: exercise.map(|e| e.attempts.clone()).unwrap_or_default(),
+        ..XrReport::new(Method::Xpbd, &outcome.log, headset)
     };
-    let json = serde_json::to_string_pretty(&report)?;
-    let path = opts.out.join("xr_report.json");
-    incise_sim::io::write_atomic(&path, json.as_bytes())
-        .with_context(|| format!("writing {}", path.display()))?;
+    report.save(&outcome.log, &opts.out)?;
     match outcome.error.take() {
-        Some(e) => Err(e.context(format!(
-            "the XR session failed after {} display frames; the frame log, the stroke and xr_report.json in {} were kept",
+        Some(e) => Err(xr_report::failed(
+            e,
             outcome.frames,
-            opts.out.display()
-        ))),
+            "the frame log, the stroke and xr_report.json",
+            &opts.out,
+        )),
         // Ctrl-C: the session ended cleanly, but the run was cut short (exit 130).
         None if outcome.interrupted => Err(crate::interrupt::Interrupted {
             what: format!("the XR session on {}", report.scene),
@@ -396,28 +305,5 @@ fn run_session(
         }
         .into()),
         None => Ok(report),
-    }
-}
-
-impl XrReport {
-    /// One line for the terminal.
-    pub fn summary(&self) -> String {
-        let latency = match self.tool_latency_ms_p50_p95 {
-            Some((p50, p95)) => format!("{p50:.0}/{p95:.0} ms"),
-            None => "-".into(),
-        };
-        format!(
-            "{} display frames ({} rendered, {} dropped), {} simulation frames ({:.1}/s, {}), tool-to-tissue latency p50/p95 {}, {} tets released, tool force up to {:.2} N, exit {}",
-            self.frames,
-            self.rendered,
-            self.dropped_frames,
-            self.sim_frames,
-            self.sim_steps_per_s,
-            self.sim_mode,
-            latency,
-            self.released_tets,
-            self.max_tool_force,
-            self.exit
-        )
     }
 }
