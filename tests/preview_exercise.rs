@@ -55,7 +55,7 @@ fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
         hand.before_step(&mut body).unwrap();
         let stats = body.step_frame().unwrap();
         hand.after_step(&stats);
-        mode.after_step(&stats);
+        mode.after_step(incise::exercise::ToolFrame::of_xpbd(&stats));
     }
     assert_eq!(mode.running(), Some(frames as usize));
     let live_released: Vec<u64> = (0..body.solver().mesh().tet_count())
@@ -142,4 +142,64 @@ fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
         std::fs::read_to_string(&history).unwrap().lines().count(),
         2
     );
+}
+
+/// The method window's attempt on the Nakao plate exercise, without a window: the
+/// reference stroke moves the mouse blade (engaged), the attempt records its pose each
+/// frame and is scored on the body's cut surface; `incise exercise` on the recorded
+/// stroke.ron cuts the same surface and gives the same score.
+#[test]
+fn a_method_window_attempt_on_a_nakao_exercise_scores_as_incise_exercise_does() {
+    use incise::preview::method_exercise::MethodExercise;
+    use incise::sim_body::ToolInput;
+    use incise::sim_body::recorded::RecordedBody;
+    const NAKAO: &str = "config/exercises/plate_line_nakao.ron";
+    let dir = temp_dir("preview-exercise-nakao");
+    let history = dir.join("history.jsonl");
+    let mut mode = MethodExercise::open(Path::new(NAKAO)).unwrap();
+    let mut body = RecordedBody::open(mode.live.scene_path()).unwrap();
+    let reference = mode.live.reference().unwrap();
+    let dt = body.body.frame_dt();
+    let frames = (reference.end_time() / dt).ceil() as u64;
+    mode.start(&mut body).unwrap();
+    assert!(!mode.live.touched());
+    for f in 1..=frames {
+        let pose = reference.pose_at(f as f64 * dt);
+        body.step(&ToolInput::Hand {
+            pose,
+            engaged: true,
+        })
+        .unwrap();
+        mode.after_step(&body, pose).unwrap();
+    }
+    assert!(mode.live.touched(), "the blade never touched the plate");
+    assert_eq!(mode.live.running(), Some(frames as usize));
+    let done = mode
+        .finish(&body, &dir.join("out/exercises"), &history)
+        .unwrap();
+    let live = json(&done.attempt.result_path);
+    assert_eq!(
+        (live["method"].as_str(), live["verdict"]["passed"].as_bool()),
+        (Some("nakao"), Some(true)),
+        "{}",
+        live["verdict"]
+    );
+    let replay = dir.join("replay");
+    score_stroke(NAKAO, &done.stroke, &replay, &history);
+    let cli = json(&replay.join("result.json"));
+    for key in [
+        "cut_faces",
+        "cut_area",
+        "completion",
+        "mean_deviation",
+        "max_depth",
+    ] {
+        assert_eq!(cli["metrics"][key], live["metrics"][key], "{key}");
+    }
+    let (a, b) = (
+        live["verdict"]["score"].as_f64().unwrap(),
+        cli["verdict"]["score"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() < 0.5, "live {a} vs incise exercise {b}");
+    assert!(done.dir.join("card.png").is_file() && done.attempt.html_path.is_file());
 }

@@ -208,6 +208,55 @@ fn an_exercise_draws_its_plan_on_the_tissue() {
     );
 }
 
+/// A Nakao exercise opens in the method window with its plan drawn on the plate (the
+/// panel offers its attempts): the same violet line as an XPBD exercise's.
+#[test]
+fn a_nakao_exercise_draws_its_plan_in_the_method_window() {
+    let Some(img) = preview_screenshot(
+        "xvfb-exercise-nakao",
+        &[
+            "--exercise",
+            "config/exercises/plate_line_nakao.ron",
+            "--frames",
+            "10",
+            "--size",
+            "900x600",
+        ],
+    ) else {
+        return;
+    };
+    let violet = (0..img.height)
+        .flat_map(|y| (300..img.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.get(x, y);
+            p[2] as i32 > p[1] as i32 + 60 && p[0] as i32 > p[1] as i32 + 20
+        })
+        .count();
+    eprintln!("{violet} violet pixels");
+    assert!(
+        (60..5000).contains(&violet),
+        "the plan line should be on the plate: {violet} violet pixels"
+    );
+    // The blade is the mouse's from the start: the scene's scripted cut (from 0.2 s) does
+    // not open the plate before an attempt.
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24"])
+        .arg(env!("CARGO_BIN_EXE_incise"))
+        .args([
+            "preview",
+            "--exercise",
+            "config/exercises/plate_line_nakao.ron",
+        ])
+        .args(["--frames", "50", "--device", "cpu"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("XDG_RUNTIME_DIR", temp_dir("xvfb-exercise-nakao-script"))
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.contains("cut added 0 nodes and 0 tets"), "{out}");
+}
+
 #[test]
 fn without_a_display_preview_refuses_and_the_default_runs_headless() {
     let o = Command::new(env!("CARGO_BIN_EXE_incise"))

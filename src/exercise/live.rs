@@ -3,12 +3,13 @@
 //! recorded (by a [`StrokeSource`]: the preview's mouse blade, the right controller) and
 //! every frame's statistics kept, finished by scoring the live body with the same
 //! [`score_attempt`] as `incise exercise` and saving result.json, report.html, the stroke
-//! and the result card. No window needed: tests drive it with a source and a [`Body`].
+//! and the result card. No window needed: tests drive it with a source and a body: an
+//! XPBD [`Body`] (the preview's and headset's XPBD sessions) or any method's
+//! [`RecordedBody`] (the method window: a Nakao cut surface is scored).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
-use incise_sim::xpbd::FrameStats;
 use incise_xr::RgbaImage;
 
 use super::{
@@ -16,13 +17,15 @@ use super::{
     load_exercise, read_history, reference_stroke, render_card, save_attempt, score_attempt,
 };
 use crate::pictures::screenshots::Screenshots;
+use crate::pictures::view_pictures::ViewPictures;
+use crate::sim_body::recorded::RecordedBody;
 use crate::sim_body::{Body, RestCut};
 
-/// Where a live attempt's scalpel path is recorded: the preview's hand tool, the XR
-/// mode's controller.
-pub trait StrokeSource {
+/// Where a live attempt's scalpel path is recorded on a body `B`: the preview's hand
+/// tool, the XR mode's controller, the method window's mouse blade.
+pub trait StrokeSource<B: ?Sized = Body> {
     /// Start recording on `body`, which is at frame 0.
-    fn start_recording(&mut self, body: &mut Body) -> Result<()>;
+    fn start_recording(&mut self, body: &mut B) -> Result<()>;
     /// Whether a recording is running.
     fn is_recording(&self) -> bool;
     /// Stop recording and write the stroke to `path` atomically.
@@ -31,22 +34,75 @@ pub trait StrokeSource {
     fn abort_recording(&mut self);
 }
 
-/// An exercise open on a live body.
-pub struct LiveExercise {
+/// What an attempt needs of the body it is made on.
+pub trait AttemptBody {
+    /// The offscreen renderer of the report's pictures of this body.
+    type Pictures;
+    /// Tets of the body's mesh, where they must be the exercise mesh's (XPBD releases
+    /// them by index); `None` where a cut remodels the mesh.
+    fn scene_tets(&self) -> Option<usize>;
+    /// What the body has cut, at rest.
+    fn rest_cut(&self) -> Result<RestCut>;
+    /// Where the body runs.
+    fn device(&self) -> String;
+    /// A picture of the body now.
+    fn picture(&self, pictures: &mut Self::Pictures) -> Result<RgbaImage>;
+}
+
+impl AttemptBody for Body {
+    type Pictures = Screenshots;
+    fn scene_tets(&self) -> Option<usize> {
+        Some(self.solver().mesh().tet_count())
+    }
+    fn rest_cut(&self) -> Result<RestCut> {
+        let live = self.solver().cut().live();
+        Ok(RestCut::Released(live.iter().map(|l| !l).collect()))
+    }
+    fn device(&self) -> String {
+        Body::device(self)
+    }
+    fn picture(&self, pictures: &mut Screenshots) -> Result<RgbaImage> {
+        pictures.image(self)
+    }
+}
+
+impl AttemptBody for RecordedBody {
+    type Pictures = ViewPictures;
+    fn scene_tets(&self) -> Option<usize> {
+        None
+    }
+    fn rest_cut(&self) -> Result<RestCut> {
+        self.body.rest_cut().ok_or_else(|| {
+            anyhow!(
+                "a {} body leaves no cut to score",
+                self.body.method().name()
+            )
+        })
+    }
+    fn device(&self) -> String {
+        self.body.device()
+    }
+    fn picture(&self, pictures: &mut ViewPictures) -> Result<RgbaImage> {
+        pictures.image(self.body.tet_view())
+    }
+}
+
+/// An exercise open on a live body, its report's pictures taken by `P`.
+pub struct LiveExercise<P = Screenshots> {
     /// The exercise, its scene and plan.
     pub exercise: LoadedExercise,
     /// The plan as a line on the tissue.
     pub decal: PlanDecal,
-    attempt: Option<Running>,
+    attempt: Option<Running<P>>,
 }
 
 /// An attempt under way.
-struct Running {
-    /// Statistics of every frame since the start.
-    stats: Vec<FrameStats>,
+struct Running<P> {
+    /// The tool figures of every frame since the start.
+    tool: Vec<ToolFrame>,
     /// The renderer for the report's pictures and the picture at the start, or why there
     /// are none.
-    pictures: Result<(Screenshots, RgbaImage), String>,
+    pictures: Result<(P, RgbaImage), String>,
 }
 
 /// A finished, scored and saved attempt.
@@ -63,9 +119,9 @@ pub struct Finished {
     pub card: RgbaImage,
 }
 
-impl LiveExercise {
+impl<P> LiveExercise<P> {
     /// Load the exercise at `path` and lay its plan on the mesh.
-    pub fn open(path: &Path) -> Result<LiveExercise> {
+    pub fn open(path: &Path) -> Result<LiveExercise<P>> {
         let exercise = load_exercise(path)?;
         let decal = PlanDecal::new(&exercise.plan, &exercise.mesh);
         Ok(LiveExercise {
@@ -88,13 +144,16 @@ impl LiveExercise {
     /// Start an attempt on `body`, which must be the exercise's scene as loaded (frame 0):
     /// the scalpel's poses are recorded from now on, and the start is pictured with
     /// `pictures` (the renderer for the report, or why there is none).
-    pub fn start(
+    pub fn start<B: AttemptBody<Pictures = P> + ?Sized>(
         &mut self,
-        hand: &mut dyn StrokeSource,
-        body: &mut Body,
-        pictures: Result<Screenshots, String>,
+        hand: &mut dyn StrokeSource<B>,
+        body: &mut B,
+        pictures: Result<P, String>,
     ) -> Result<()> {
-        if body.solver().mesh().tet_count() != self.exercise.mesh.tet_count() {
+        if body
+            .scene_tets()
+            .is_some_and(|n| n != self.exercise.mesh.tet_count())
+        {
             bail!(
                 "the scene running is not {}'s scene {}",
                 self.exercise.exercise.name,
@@ -104,11 +163,11 @@ impl LiveExercise {
         hand.abort_recording();
         hand.start_recording(body)?;
         let pictures = pictures.and_then(|mut shots| {
-            let before = shots.image(body).map_err(|e| format!("{e:#}"))?;
+            let before = body.picture(&mut shots).map_err(|e| format!("{e:#}"))?;
             Ok((shots, before))
         });
         self.attempt = Some(Running {
-            stats: Vec::new(),
+            tool: Vec::new(),
             pictures,
         });
         Ok(())
@@ -118,35 +177,35 @@ impl LiveExercise {
     pub fn touched(&self) -> bool {
         self.attempt
             .as_ref()
-            .is_some_and(|a| a.stats.iter().any(|s| s.contact_nodes > 0))
+            .is_some_and(|a| a.tool.iter().any(|f| f.contact))
     }
 
     /// Frames simulated in the attempt under way, if one is.
     pub fn running(&self) -> Option<usize> {
-        self.attempt.as_ref().map(|a| a.stats.len())
+        self.attempt.as_ref().map(|a| a.tool.len())
     }
 
-    /// Keep a simulated frame's statistics (nothing without an attempt).
-    pub fn after_step(&mut self, stats: &FrameStats) {
+    /// Keep a simulated frame's tool figures (nothing without an attempt).
+    pub fn after_step(&mut self, frame: ToolFrame) {
         if let Some(a) = &mut self.attempt {
-            a.stats.push(stats.clone());
+            a.tool.push(frame);
         }
     }
 
     /// Drop the attempt under way (the scene changed under it); whether there was one.
-    pub fn abort(&mut self, hand: &mut dyn StrokeSource) -> bool {
+    pub fn abort<B: ?Sized>(&mut self, hand: &mut dyn StrokeSource<B>) -> bool {
         hand.abort_recording();
         self.attempt.take().is_some()
     }
 
-    /// Finish the attempt: score `body` as it is now (its released tets and the frames
-    /// kept), and save into a new folder `out_root/<exercise>-<UTC time>/` the recorded
+    /// Finish the attempt: score `body` as it is now (what it cut and the frames kept),
+    /// and save into a new folder `out_root/<exercise>-<UTC time>/` the recorded
     /// stroke.ron, result.json, report.html (with pictures of the start and now when a
     /// renderer was given), and card.png; the attempt is appended to `history`.
-    pub fn finish(
+    pub fn finish<B: AttemptBody<Pictures = P> + ?Sized>(
         &mut self,
-        hand: &mut dyn StrokeSource,
-        body: &Body,
+        hand: &mut dyn StrokeSource<B>,
+        body: &B,
         out_root: &Path,
         history: &Path,
     ) -> Result<Finished> {
@@ -157,7 +216,7 @@ impl LiveExercise {
         // The frames of the attempt are those whose statistics were kept (the XR mode
         // rebuilds its solver when it changes substeps, which restarts the solver's own
         // frame count).
-        let frames = running.stats.len() as u64;
+        let frames = running.tool.len() as u64;
         if frames == 0 {
             bail!("the attempt has not simulated a frame yet");
         }
@@ -171,19 +230,17 @@ impl LiveExercise {
         let dir = new_attempt_dir(out_root, name)?;
         let stroke = dir.join("stroke.ron");
         hand.save_recording(&stroke)?;
-        let released = body.solver().cut().live().iter().map(|l| !l).collect();
-        let tool: Vec<ToolFrame> = running.stats.iter().map(ToolFrame::of_xpbd).collect();
         let result = score_attempt(
             &self.exercise,
             &stroke.display().to_string(),
             body.device(),
-            &RestCut::Released(released),
-            &tool,
+            &body.rest_cut()?,
+            &running.tool,
             frames,
         )?;
         let (before, after) = (dir.join("before.png"), dir.join("after.png"));
         let images = match running.pictures {
-            Ok((mut shots, first)) => match shots.image(body) {
+            Ok((mut shots, first)) => match body.picture(&mut shots) {
                 Ok(last) => {
                     first.save_png(&before)?;
                     last.save_png(&after)?;

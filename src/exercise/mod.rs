@@ -24,7 +24,7 @@ pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, PlanDecal};
 pub use history::{
     HistoryEntry, append as append_history, read as read_history, table as history_table, utc_now,
 };
-pub use live::{Finished, LiveExercise, StrokeSource};
+pub use live::{AttemptBody, Finished, LiveExercise, StrokeSource};
 pub use load::{LoadedExercise, load_exercise, parse_exercise};
 pub use metrics::{Metrics, STROKE_GAP_FRAMES, ToolFrame, compute as compute_metrics};
 pub use model::{Exercise, PassThresholds, Tolerance};

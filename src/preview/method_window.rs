@@ -7,15 +7,17 @@
 //! frame: the level chosen (by the refresh-rate manager under a budget), the free nodes
 //! and the loop's time split. `--frames N` steps and draws N frames and closes, printing
 //! the body's report summary (what it cut, how deep it was pressed) and the last frame's
-//! localisation lines as the panel showed them.
+//! localisation lines as the panel showed them. With a Nakao exercise the plan is drawn on
+//! the tissue and the panel starts and finishes attempts ([`MethodExercise`]).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use incise_xr::{Overlays, RenderSettings, Renderer};
 use winit::event::ElementState;
 
 use super::camera_input::preview_camera;
+use super::method_exercise::MethodExercise;
 use super::pick::pick_tissue;
 use super::scalpel_input::{BladeGeometry, ScalpelFeel, ScalpelInput};
 use super::window_app::{WindowContent, WindowShell, run_window, save_frame};
@@ -29,6 +31,8 @@ use crate::sim_body::ToolInput;
 pub struct MethodWindow {
     /// The scene.
     pub scene: PathBuf,
+    /// An exercise on the scene (a Nakao one): its plan drawn, attempts scored.
+    pub exercise: Option<PathBuf>,
     /// Step and draw this many frames, then close.
     pub frames: Option<u64>,
     /// Save the last frame here.
@@ -62,6 +66,8 @@ struct Live {
     playing: bool,
     frames: u64,
     message: String,
+    /// The open exercise.
+    exercise: Option<MethodExercise>,
 }
 
 impl WindowContent for Live {
@@ -74,8 +80,12 @@ impl WindowContent for Live {
         if self.playing {
             let tool = self.tool_input();
             match self.body.step(&tool) {
-                Ok(true) => self.renderer = renderer_for(&self.shell.gpu, &self.body),
-                Ok(false) => {}
+                Ok(remodelled) => {
+                    if remodelled {
+                        self.renderer = renderer_for(&self.shell.gpu, &self.body);
+                    }
+                    self.keep_for_attempt(&tool);
+                }
                 Err(e) => {
                     self.playing = false;
                     self.message = format!("solver stopped: {e}");
@@ -91,6 +101,11 @@ impl WindowContent for Live {
                 ..Overlays::default()
             },
             stress_max: self.body.drawing.scale,
+            lines: self
+                .exercise
+                .iter()
+                .map(|e| e.line(self.body.state().positions))
+                .collect(),
             ..RenderSettings::default()
         };
         let view = self.shell.view_beside(panel_points, panel.pixels_per_point);
@@ -148,6 +163,11 @@ impl WindowContent for Live {
 
 impl Live {
     fn open(mut shell: WindowShell, w: MethodWindow) -> Result<Live> {
+        let exercise = w
+            .exercise
+            .as_deref()
+            .map(MethodExercise::open)
+            .transpose()?;
         let body = DrawnBody::open(&w.scene)?;
         let renderer = renderer_for(&shell.gpu, &body);
         let home = preview_camera(&body.drawing.render.mesh);
@@ -155,23 +175,83 @@ impl Live {
         let (lo, hi) = body.drawing.render.mesh.rest_bounds();
         let top = glam::Vec3::new(0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), hi.z);
         let tool = crate::scene::hand_tool::default_tool()?;
-        let scalpel = ScalpelInput::new(
+        let mut scalpel = ScalpelInput::new(
             BladeGeometry::of(&tool),
             ScalpelFeel::default(),
             top,
             home.yaw + std::f32::consts::FRAC_PI_2,
         );
+        if exercise.is_some() {
+            scalpel.take_over(scalpel.target_pose());
+        }
         Ok(Live {
             shell,
             w,
             body,
             renderer,
             scalpel,
-            hand: false,
+            // An exercise's blade is the mouse's from the start: the scene's own scripted
+            // cut must not open the tissue before the attempt.
+            hand: exercise.is_some(),
             playing: true,
             frames: 0,
-            message: String::new(),
+            message: exercise.as_ref().map_or(String::new(), |e| {
+                format!(
+                    "exercise {}: cut along the violet line; Start attempt when ready",
+                    e.live.exercise.exercise.name
+                )
+            }),
+            exercise,
         })
+    }
+
+    /// After a frame stepped with `tool`: the attempt under way keeps its figures and the
+    /// blade's pose.
+    fn keep_for_attempt(&mut self, tool: &ToolInput) {
+        let (Some(e), ToolInput::Hand { pose, .. }) = (&mut self.exercise, tool) else {
+            return;
+        };
+        if let Err(err) = e.after_step(&self.body.sim, *pose) {
+            self.message = format!("{err:#}");
+        }
+    }
+
+    /// Start an attempt: the scene as loaded, the blade in the mouse's hand.
+    fn start_attempt(&mut self) {
+        let Some(e) = &mut self.exercise else {
+            return;
+        };
+        let started = DrawnBody::open(&self.w.scene).and_then(|mut body| {
+            e.start(&mut body.sim)?;
+            Ok(body)
+        });
+        match started {
+            Ok(body) => {
+                self.body = body;
+                self.renderer = renderer_for(&self.shell.gpu, &self.body);
+                self.hand = true;
+                self.scalpel.take_over(self.scalpel.target_pose());
+                self.playing = true;
+                self.message = "attempt under way: cut along the line, then Finish".into();
+            }
+            Err(err) => self.message = format!("{err:#}"),
+        }
+    }
+
+    /// Finish the attempt under way: scored, saved, its verdict in the panel.
+    fn finish_attempt(&mut self) {
+        let Some(e) = &mut self.exercise else {
+            return;
+        };
+        let out = Path::new(super::ATTEMPTS_DIR);
+        self.message = match e.finish(&self.body.sim, out, Path::new(super::HISTORY_FILE)) {
+            Ok(done) => format!(
+                "{}\nsaved in {}",
+                done.attempt.result.summary(),
+                done.dir.display()
+            ),
+            Err(err) => format!("{err:#}"),
+        };
     }
 
     /// What moves the tool this frame: the scene's script until the mouse took it.
@@ -192,6 +272,8 @@ impl Live {
         let (method, quantity) = (body.sim.body.method().name(), body.quantity());
         let live_lines = body.sim.live_lines();
         let (mut width, mut playing) = (0.0, self.playing);
+        let (mut start, mut finish) = (false, false);
+        let attempt = self.exercise.as_ref().map(|e| e.live.running());
         let message = &self.message;
         let frame = self.shell.panel(|ui| {
             let shown = egui::Panel::left("method")
@@ -213,6 +295,14 @@ impl Live {
                         ui.label(line.as_str());
                     }
                     ui.checkbox(&mut playing, "play (Space)");
+                    if let Some(running) = attempt {
+                        ui.separator();
+                        start = ui.button("Start attempt").clicked();
+                        if let Some(frames) = running {
+                            ui.label(format!("attempt: {frames} frames"));
+                            finish = ui.button("Finish attempt").clicked();
+                        }
+                    }
                     ui.small("Left-drag: cut or press · right-drag: orbit · wheel: zoom");
                     if !message.is_empty() {
                         ui.label(message.as_str());
@@ -221,6 +311,12 @@ impl Live {
             width = shown.response.rect.width();
         });
         self.playing = playing;
+        if start {
+            self.start_attempt();
+        }
+        if finish {
+            self.finish_attempt();
+        }
         (frame, width)
     }
 }

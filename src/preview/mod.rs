@@ -9,6 +9,7 @@ mod camera_input;
 pub mod display;
 mod frame_times;
 pub mod hand_tool;
+pub mod method_exercise;
 pub mod method_window;
 mod panel;
 pub mod pick;
@@ -28,7 +29,7 @@ use winit::keyboard::ModifiersState;
 use crate::pictures::screenshots::{ImageSize, Screenshots, stress_scale};
 use crate::sim_body::{Body, DeviceChoice};
 
-use crate::exercise::LiveExercise;
+use crate::exercise::{LiveExercise, ToolFrame};
 use camera_input::{preview_camera, wheel_steps};
 use frame_times::{FrameTime, FrameTimes};
 use panel::{Action, ExerciseInfo, Panel, PanelInfo, ScalpelInfo};
@@ -66,9 +67,14 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
     if let Some(why) = display::missing_display() {
         bail!("{why}: the preview needs a window; use `incise run` or `incise render` headless");
     }
-    if opts.exercise.is_none() && !is_xpbd(&opts.scene)? {
+    let scene = match &opts.exercise {
+        Some(e) => crate::exercise::load_exercise(e)?.scene_path,
+        None => opts.scene.clone(),
+    };
+    if !is_xpbd(&scene)? {
         return method_window::run(method_window::MethodWindow {
-            scene: opts.scene,
+            scene,
+            exercise: opts.exercise,
             frames: opts.frames,
             screenshot: opts.screenshot,
             size: opts.size,
@@ -89,7 +95,7 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
 
 /// Whether the scene at `path` runs the XPBD method (the full preview with its panel of
 /// solver settings, exercises and stroke recording); other methods get a
-/// [`method_window`].
+/// [`method_window`] (with a Nakao scene's exercise).
 fn is_xpbd(path: &Path) -> Result<bool> {
     let scene = crate::scene::load_scene(path)?;
     Ok(matches!(scene.model, crate::scene::ModelChoice::Xpbd))
@@ -354,7 +360,7 @@ impl Live {
     fn step(&mut self) -> Result<f64, String> {
         let (stats, ms) = self.session.step()?;
         if let Some(e) = &mut self.exercise {
-            e.after_step(&stats);
+            e.after_step(ToolFrame::of_xpbd(&stats));
         }
         Ok(ms)
     }

@@ -46,6 +46,11 @@ impl RecordedBody {
         self.report.frames.len()
     }
 
+    /// The statistics of the last frame stepped, if any.
+    pub fn last_frame(&self) -> Option<&FrameData> {
+        self.report.frames.last().map(|f| &f.stats)
+    }
+
     /// The last frame's localisation as a live view shows it: the level chosen (by the
     /// refresh-rate manager under a budget) and the loop's time split; empty for other
     /// methods and before the first frame.

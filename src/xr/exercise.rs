@@ -19,7 +19,7 @@ use incise_xr::{RenderDevice, Renderer, RgbaImage, SurfaceLine};
 use serde::Serialize;
 
 use super::xr_body::XrBody;
-use crate::exercise::{LiveExercise, LoadedExercise, StrokeSource};
+use crate::exercise::{LiveExercise, LoadedExercise, StrokeSource, ToolFrame};
 use crate::pictures::screenshots::{ImageSize, Screenshots};
 use crate::sim_body::Body;
 
@@ -132,7 +132,7 @@ impl XrExercise {
         pose: Option<ToolPose>,
         dt: f64,
     ) -> Result<()> {
-        self.live.after_step(stats);
+        self.live.after_step(ToolFrame::of_xpbd(stats));
         // The attempt's clock: its frames so far (none kept without an attempt).
         let frames = self.live.running().unwrap_or(0);
         if let (Some(r), Some(p)) = (&mut self.stroke.recorder, pose) {

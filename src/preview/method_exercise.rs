@@ -1,0 +1,108 @@
+//! An exercise in the method window, on a Nakao scene (docs/scoring.md, "A cut surface"):
+//! the plan drawn on the tissue, an attempt started from the scene as loaded with the
+//! mouse blade's pose recorded every frame, finished by scoring the body's cut surface
+//! as `incise exercise` scores the recorded stroke, and saved with its report and card.
+//! No window needed: tests drive it with a [`RecordedBody`] and poses.
+
+use std::path::Path;
+
+use anyhow::{Result, bail};
+use glam::Vec3;
+use incise_scalpel::StrokeRecorder;
+use incise_sim::contact::ToolPose;
+use incise_xr::{Overlays, SurfaceLine};
+
+use crate::exercise::{Finished, LiveExercise, StrokeSource, ToolFrame};
+use crate::pictures::screenshots::ImageSize;
+use crate::pictures::view_pictures::ViewPictures;
+use crate::sim_body::recorded::RecordedBody;
+
+/// Size of the report's before/after pictures, pixels.
+const PICTURE: ImageSize = ImageSize(960, 540);
+
+/// The mouse blade's path during an attempt, one key per simulated frame at the frame's
+/// end (so `incise exercise --stroke` puts the blade where it was, frame for frame).
+#[derive(Default)]
+pub struct MouseStroke {
+    recorder: Option<StrokeRecorder>,
+}
+
+impl StrokeSource<RecordedBody> for MouseStroke {
+    fn start_recording(&mut self, body: &mut RecordedBody) -> Result<()> {
+        if body.frames() != 0 {
+            bail!("an attempt starts from the scene as loaded (frame 0)");
+        }
+        self.recorder = Some(StrokeRecorder::new());
+        Ok(())
+    }
+
+    fn is_recording(&self) -> bool {
+        self.recorder.is_some()
+    }
+
+    fn save_recording(&mut self, path: &Path) -> Result<()> {
+        let Some(r) = self.recorder.take() else {
+            bail!("not recording");
+        };
+        r.finish()?.save(path)?;
+        Ok(())
+    }
+
+    fn abort_recording(&mut self) {
+        self.recorder = None;
+    }
+}
+
+/// An exercise open in the method window.
+pub struct MethodExercise {
+    /// The exercise and its attempt under way.
+    pub live: LiveExercise<ViewPictures>,
+    stroke: MouseStroke,
+}
+
+impl MethodExercise {
+    /// Open the exercise at `path`.
+    pub fn open(path: &Path) -> Result<MethodExercise> {
+        Ok(MethodExercise {
+            live: LiveExercise::open(path)?,
+            stroke: MouseStroke::default(),
+        })
+    }
+
+    /// Start an attempt on `body`, the exercise's scene as loaded.
+    pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
+        let heat_map = Overlays {
+            stress: true,
+            ..Overlays::default()
+        };
+        let pictures = ViewPictures::new(PICTURE, heat_map).map_err(|e| format!("{e:#}"));
+        self.live.start(&mut self.stroke, body, pictures)
+    }
+
+    /// After `body` stepped a frame with the blade at `pose`: keep the frame's tool figures
+    /// and the pose, at the frame's end (nothing without an attempt).
+    pub fn after_step(&mut self, body: &RecordedBody, pose: ToolPose) -> Result<()> {
+        let (Some(frame), Some(r)) = (body.last_frame(), &mut self.stroke.recorder) else {
+            return Ok(());
+        };
+        self.live.after_step(ToolFrame::of(frame));
+        r.push(body.body.time(), pose)?;
+        Ok(())
+    }
+
+    /// Finish the attempt on `body`: scored, saved under `out_root`, appended to `history`.
+    pub fn finish(
+        &mut self,
+        body: &RecordedBody,
+        out_root: &Path,
+        history: &Path,
+    ) -> Result<Finished> {
+        self.live.finish(&mut self.stroke, body, out_root, history)
+    }
+
+    /// The plan on the tissue whose original nodes are at `positions` (the cut appends its
+    /// new nodes after them, so the line follows the tissue it was laid on).
+    pub fn line(&self, positions: &[Vec3]) -> SurfaceLine {
+        self.live.decal.line(positions)
+    }
+}
