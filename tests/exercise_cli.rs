@@ -475,8 +475,8 @@ fn intestine_reference_stroke_passes_its_exercise() {
 /// The Nakao plate exercise (a cut surface, not released tets, is scored): the shipped
 /// reference stroke, the blade upright with its heel through the 4 mm plate along the
 /// line, passes with the whole plan cut through; the same stroke 5 mm to the side cuts
-/// nothing of the plan and damages tissue outside the band; lifted 2 mm it leaves the
-/// plate's lower half uncut.
+/// nothing of the plan and damages tissue outside the band; lifted 2 mm (the heel 2.5 mm
+/// deep) it fails on depth.
 #[test]
 fn nakao_plate_exercise_scores_the_cut_surface() {
     reference_passes("plate_line_nakao");

@@ -319,8 +319,14 @@ fn a_lost_or_ending_runtime_stops_the_session_cleanly_and_keeps_its_outputs() {
 /// draws the exercise's reference stroke from 0.1 s with the trigger held; then `extra`
 /// (buttons, faults, screenshots) — eyes 480 px square, every 12th frame drawn.
 fn exercise_script(duration: f64, extra: &str) -> String {
-    let stroke =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("config/strokes/slab_depth_reference.ron");
+    stroke_script("slab_depth_reference.ron", duration, extra)
+}
+
+/// [`exercise_script`] with the right controller drawing `config/strokes/STROKE`.
+fn stroke_script(stroke: &str, duration: f64, extra: &str) -> String {
+    let stroke = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("config/strokes")
+        .join(stroke);
     format!(
         "(duration: {duration}, eye_size: (480, 480), render_every: 12, pacing: Nominal, \
          head: [(t: 0.0, position: (0.0, 1.02, -0.36), orientation: (-0.42262, 0.0, 0.0, 0.90631)), \
@@ -337,6 +343,16 @@ fn run_exercise_session(
     script: &str,
     extra: &[&str],
 ) -> (std::path::PathBuf, Value, std::process::Output) {
+    run_exercise_on("config/exercises/slab_depth.ron", name, script, extra)
+}
+
+/// [`run_exercise_session`] on the exercise file `exercise`.
+fn run_exercise_on(
+    exercise: &str,
+    name: &str,
+    script: &str,
+    extra: &[&str],
+) -> (std::path::PathBuf, Value, std::process::Output) {
     // The history goes into the output folder (created by incise).
     let out_dir = std::env::temp_dir()
         .join(format!("incise-e2e-{}-{name}", std::process::id()))
@@ -344,7 +360,7 @@ fn run_exercise_session(
     let history = out_dir.join("history.jsonl");
     let mut args = vec![
         "--exercise",
-        "config/exercises/slab_depth.ron",
+        exercise,
         "--history",
         history.to_str().unwrap(),
     ];
@@ -653,4 +669,73 @@ fn a_failing_or_panicking_simulation_thread_keeps_the_outputs() {
     );
     let stroke = incise_scalpel::load_stroke(&out.join("stroke.ron")).unwrap();
     assert!(stroke.keys().len() >= 2, "the stroke up to the panic");
+}
+
+/// A Nakao exercise in the headset: the body stepped in the frame, the blade the
+/// controller's from the start (the plate's scripted cut does not run), the plan drawn
+/// on the plate, A finishes the attempt, scored on the cut surface as `incise exercise`
+/// scores its recorded stroke, and hangs the card.
+#[test]
+fn a_nakao_exercise_in_the_headset_is_scored_on_its_cut_surface() {
+    // The reference stroke runs 0.1–3.5 s; A at 3.7 s; eyes saved at frames 72 (1 s) and
+    // 276 (3.83 s).
+    let script = stroke_script(
+        "plate_line_nakao_reference.ron",
+        4.0,
+        "buttons: [(3.7, A)], screenshots: [72, 276]",
+    );
+    let exercise = "config/exercises/plate_line_nakao.ron";
+    let (out, r, o) = run_exercise_on(exercise, "xr-exercise-nakao", &script, &[]);
+    let err = text(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert_eq!(
+        (r["method"].as_str(), r["sim_mode"].as_str()),
+        (Some("nakao"), Some("in-frame")),
+        "{r}"
+    );
+    let attempts = r["attempts"].as_array().unwrap();
+    assert_eq!(attempts.len(), 1, "{r}");
+    assert_eq!(attempts[0]["ended_by"], "A pressed");
+    assert_eq!(attempts[0]["passed"], true, "{}: {err}", attempts[0]);
+    let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
+    let live: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("result.json")).unwrap()).unwrap();
+    assert_eq!(live["method"], "nakao");
+    assert!(
+        live["metrics"]["cut_faces"].as_u64().unwrap() > 20,
+        "{}",
+        live["metrics"]
+    );
+    // The replay of the recorded stroke scores within 2 points.
+    let replay = out.join("replay");
+    common::score_stroke(
+        exercise,
+        &dir.join("stroke.ron"),
+        &replay,
+        &out.join("h2.jsonl"),
+    );
+    let cli: Value =
+        serde_json::from_str(&std::fs::read_to_string(replay.join("result.json")).unwrap())
+            .unwrap();
+    let (a, b) = (
+        live["verdict"]["score"].as_f64().unwrap(),
+        cli["verdict"]["score"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() < 2.0, "live {a} vs incise exercise {b}");
+    let before = RgbaImage::load_png(&out.join("eye_left_00072.png")).unwrap();
+    let after = RgbaImage::load_png(&out.join("eye_left_00276.png")).unwrap();
+    let violet = (0..before.height)
+        .flat_map(|y| (0..before.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = before.get(x, y).map(i32::from);
+            p[2] > p[1] + 30 && p[0] > p[1] + 10
+        })
+        .count();
+    assert!(violet > 10, "plan drawn: {violet} violet pixels");
+    assert!(
+        card_pixels(&before) < 20 && card_pixels(&after) > 500,
+        "card {} / {}",
+        card_pixels(&before),
+        card_pixels(&after)
+    );
 }

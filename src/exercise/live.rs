@@ -47,6 +47,8 @@ pub trait AttemptBody {
     fn device(&self) -> String;
     /// A picture of the body now.
     fn picture(&self, pictures: &mut Self::Pictures) -> Result<RgbaImage>;
+    /// Frames stepped since the scene was loaded.
+    fn frame(&self) -> u64;
 }
 
 impl AttemptBody for Body {
@@ -63,6 +65,9 @@ impl AttemptBody for Body {
     }
     fn picture(&self, pictures: &mut Screenshots) -> Result<RgbaImage> {
         pictures.image(self)
+    }
+    fn frame(&self) -> u64 {
+        self.solver().frame()
     }
 }
 
@@ -84,6 +89,9 @@ impl AttemptBody for RecordedBody {
     }
     fn picture(&self, pictures: &mut ViewPictures) -> Result<RgbaImage> {
         pictures.image(self.body.tet_view())
+    }
+    fn frame(&self) -> u64 {
+        self.frames() as u64
     }
 }
 

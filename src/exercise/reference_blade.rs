@@ -1,5 +1,5 @@
 //! The reference stroke of an exercise on a Nakao scene: the scene's straight blade held
-//! along the plan's surface normal, its heel at the target depth, drawn along the plan
+//! along the plan's surface normal, its heel just past the target depth, drawn along the plan
 //! from end to end (a straight edge has no belly to finish on: it cuts where it is).
 
 use anyhow::{Context, Result};
@@ -16,8 +16,8 @@ const KEY_SPACING: f64 = 0.001;
 
 /// The reference stroke of `ex`, a Nakao scene with settings `ms`: the tool (the blade's
 /// tip, PHYSICS.md §2.3) turned so that the edge stands along the plan's normal, lowered
-/// from `style.approach` above the surface until the heel is at the target depth at the
-/// plan's start, moved along the plan at `style.speed`, and lifted out at its end.
+/// from `style.approach` above the surface until the heel is a quarter of the depth
+/// tolerance past the target depth at the plan's start, moved along the plan at `style.speed`, and lifted out at its end.
 pub fn blade_reference(
     ex: &LoadedExercise,
     ms: &MassSpringScene,
@@ -25,7 +25,11 @@ pub fn blade_reference(
 ) -> Result<Stroke> {
     let edge = Blade::of_stroke(ms.stroke.clone()).edge();
     let length = edge.length();
-    let depth = ex.exercise.depth as f64;
+    // A quarter of the depth tolerance past the target: a heel held exactly on the far
+    // surface of a through cut crosses the bottom tets only partly wherever the hand
+    // rises by a hair, and the cutter opens no face there (measured in the headset: half
+    // the plate's cut surface).
+    let depth = (ex.exercise.depth + 0.25 * ex.exercise.tolerance.depth) as f64;
     let speed = style.speed as f64;
     let approach = style.approach as f64;
     let plan = &ex.plan.samples;

@@ -6,13 +6,12 @@
 
 use std::path::Path;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use glam::Vec3;
-use incise_scalpel::StrokeRecorder;
 use incise_sim::contact::ToolPose;
 use incise_xr::{Overlays, SurfaceLine};
 
-use crate::exercise::{Finished, LiveExercise, StrokeSource, ToolFrame};
+use crate::exercise::{Finished, LiveExercise, PoseRecording, ToolFrame};
 use crate::pictures::screenshots::ImageSize;
 use crate::pictures::view_pictures::ViewPictures;
 use crate::sim_body::recorded::RecordedBody;
@@ -20,44 +19,12 @@ use crate::sim_body::recorded::RecordedBody;
 /// Size of the report's before/after pictures, pixels.
 const PICTURE: ImageSize = ImageSize(960, 540);
 
-/// The mouse blade's path during an attempt, one key per simulated frame at the frame's
-/// end (so `incise exercise --stroke` puts the blade where it was, frame for frame).
-#[derive(Default)]
-pub struct MouseStroke {
-    recorder: Option<StrokeRecorder>,
-}
-
-impl StrokeSource<RecordedBody> for MouseStroke {
-    fn start_recording(&mut self, body: &mut RecordedBody) -> Result<()> {
-        if body.frames() != 0 {
-            bail!("an attempt starts from the scene as loaded (frame 0)");
-        }
-        self.recorder = Some(StrokeRecorder::new());
-        Ok(())
-    }
-
-    fn is_recording(&self) -> bool {
-        self.recorder.is_some()
-    }
-
-    fn save_recording(&mut self, path: &Path) -> Result<()> {
-        let Some(r) = self.recorder.take() else {
-            bail!("not recording");
-        };
-        r.finish()?.save(path)?;
-        Ok(())
-    }
-
-    fn abort_recording(&mut self) {
-        self.recorder = None;
-    }
-}
-
 /// An exercise open in the method window.
 pub struct MethodExercise {
     /// The exercise and its attempt under way.
     pub live: LiveExercise<ViewPictures>,
-    stroke: MouseStroke,
+    /// The mouse blade's path during an attempt.
+    stroke: PoseRecording,
 }
 
 impl MethodExercise {
@@ -65,7 +32,7 @@ impl MethodExercise {
     pub fn open(path: &Path) -> Result<MethodExercise> {
         Ok(MethodExercise {
             live: LiveExercise::open(path)?,
-            stroke: MouseStroke::default(),
+            stroke: PoseRecording::default(),
         })
     }
 
@@ -82,12 +49,11 @@ impl MethodExercise {
     /// After `body` stepped a frame with the blade at `pose`: keep the frame's tool figures
     /// and the pose, at the frame's end (nothing without an attempt).
     pub fn after_step(&mut self, body: &RecordedBody, pose: ToolPose) -> Result<()> {
-        let (Some(frame), Some(r)) = (body.last_frame(), &mut self.stroke.recorder) else {
+        let Some(frame) = body.last_frame().filter(|_| self.live.running().is_some()) else {
             return Ok(());
         };
         self.live.after_step(ToolFrame::of(frame));
-        r.push(body.body.time(), pose)?;
-        Ok(())
+        self.stroke.push(body.body.time(), pose)
     }
 
     /// Finish the attempt on `body`: scored, saved under `out_root`, appended to `history`.

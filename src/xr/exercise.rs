@@ -9,19 +9,21 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use glam::{Mat4, Vec3};
-use incise_scalpel::StrokeRecorder;
 use incise_sim::contact::ToolPose;
 use incise_sim::skin::Skin;
-use incise_sim::xpbd::FrameStats;
 use incise_xr::openxr::result_panel::panel_transform;
 use incise_xr::openxr::tray::Tray;
 use incise_xr::{RenderDevice, Renderer, RgbaImage, SurfaceLine};
 use serde::Serialize;
 
 use super::xr_body::XrBody;
-use crate::exercise::{LiveExercise, LoadedExercise, StrokeSource, ToolFrame};
+use crate::exercise::{
+    AttemptBody, LiveExercise, LoadedExercise, PlanDecal, PoseRecording, ToolFrame,
+};
 use crate::pictures::screenshots::{ImageSize, Screenshots};
+use crate::pictures::view_pictures::ViewPictures;
 use crate::sim_body::Body;
+use crate::sim_body::recorded::RecordedBody;
 
 /// Size of the report's before/after pictures, pixels.
 const PICTURE: ImageSize = ImageSize(960, 540);
@@ -39,43 +41,14 @@ pub struct AttemptSummary {
     pub ended_by: String,
 }
 
-/// The right controller's path during an attempt, timed by simulated frames since the
-/// attempt's start (so `incise exercise --stroke` replays it on the scene as loaded).
-#[derive(Default)]
-struct ControllerStroke {
-    recorder: Option<StrokeRecorder>,
-}
-
-impl StrokeSource for ControllerStroke {
-    fn start_recording(&mut self, body: &mut Body) -> Result<()> {
-        if body.solver().frame() != 0 {
-            bail!("an attempt starts from the scene as loaded (frame 0)");
-        }
-        self.recorder = Some(StrokeRecorder::new());
-        Ok(())
-    }
-
-    fn is_recording(&self) -> bool {
-        self.recorder.is_some()
-    }
-
-    fn save_recording(&mut self, path: &Path) -> Result<()> {
-        let Some(r) = self.recorder.take() else {
-            bail!("not recording");
-        };
-        r.finish()?.save(path)?;
-        Ok(())
-    }
-
-    fn abort_recording(&mut self) {
-        self.recorder = None;
-    }
-}
-
-/// The exercise state of an XR session.
-pub struct XrExercise {
-    live: LiveExercise,
-    stroke: ControllerStroke,
+/// The exercise state of an XR session on a body `B`: an XPBD [`Body`], or a Nakao
+/// scene's [`RecordedBody`] (scored on its cut surface).
+pub struct XrExercise<B: AttemptBody = Body> {
+    live: LiveExercise<B::Pictures>,
+    /// The right controller's path during an attempt, timed by simulated frames since
+    /// the attempt's start (so `incise exercise --stroke` replays it on the scene as
+    /// loaded).
+    stroke: PoseRecording,
     out_root: PathBuf,
     history: PathBuf,
     /// The card on show.
@@ -86,13 +59,13 @@ pub struct XrExercise {
     pub attempts: Vec<AttemptSummary>,
 }
 
-impl XrExercise {
+impl<B: AttemptBody> XrExercise<B> {
     /// Open the exercise at `path`; attempts are saved under `out_root` and appended to
     /// `history`.
-    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<XrExercise> {
+    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<XrExercise<B>> {
         Ok(XrExercise {
             live: LiveExercise::open(path)?,
-            stroke: ControllerStroke::default(),
+            stroke: PoseRecording::default(),
             out_root: out_root.to_path_buf(),
             history: history.to_path_buf(),
             card: None,
@@ -106,37 +79,19 @@ impl XrExercise {
         &self.live.exercise
     }
 
-    /// Start an attempt on `xr`, which is at its scene as loaded; pictures of the report
-    /// are rendered on `dev`.
-    pub fn start(&mut self, xr: &mut XrBody, skin: &Skin, dev: &RenderDevice) -> Result<()> {
-        self.card_changed |= self.card.take().is_some();
-        let pictures = Screenshots::new(Some(dev), xr.solver(), skin, PICTURE, Default::default())
-            .map(|s| {
-                let s = s
-                    .with_tool(xr.scalpel())
-                    .with_decal(self.live.decal.clone());
-                match xr.body {
-                    Body::Gpu(_) => s.with_shared_device(),
-                    Body::Cpu(_) => s,
-                }
-            })
-            .map_err(|e| format!("{e:#}"));
-        self.live.start(&mut self.stroke, &mut xr.body, pictures)
+    /// The plan on the tissue.
+    pub fn decal(&self) -> &PlanDecal {
+        &self.live.decal
     }
 
-    /// After a simulated frame: keep its statistics and the scalpel's pose (when the
+    /// After a simulated frame: keep its tool figures and the scalpel's pose (when the
     /// controller is tracked).
-    pub fn after_step(
-        &mut self,
-        stats: &FrameStats,
-        pose: Option<ToolPose>,
-        dt: f64,
-    ) -> Result<()> {
-        self.live.after_step(ToolFrame::of_xpbd(stats));
+    pub fn after_step(&mut self, frame: ToolFrame, pose: Option<ToolPose>, dt: f64) -> Result<()> {
+        self.live.after_step(frame);
         // The attempt's clock: its frames so far (none kept without an attempt).
         let frames = self.live.running().unwrap_or(0);
-        if let (Some(r), Some(p)) = (&mut self.stroke.recorder, pose) {
-            r.push(frames as f64 * dt, p)?;
+        if let Some(p) = pose {
+            self.stroke.push(frames as f64 * dt, p)?;
         }
         Ok(())
     }
@@ -144,18 +99,18 @@ impl XrExercise {
     /// A pressed. With an attempt in which the blade touched the tissue: finish it (the
     /// card is shown; returns false: keep the scene). Otherwise: returns true, the caller
     /// resets the scene and calls [`XrExercise::start`].
-    pub fn on_a(&mut self, xr: &XrBody) -> Result<bool> {
+    pub fn on_a(&mut self, xr: &B) -> Result<bool> {
         if self.live.touched() {
             self.finish(xr, "A pressed")?;
             Ok(false)
         } else {
-            self.live.abort(&mut self.stroke);
+            self.live.abort::<B>(&mut self.stroke);
             Ok(true)
         }
     }
 
     /// The session is over: finish an attempt in which the blade touched the tissue.
-    pub fn end_session(&mut self, xr: &XrBody) -> Result<()> {
+    pub fn end_session(&mut self, xr: &B) -> Result<()> {
         if self.live.touched() {
             self.finish(xr, "session ended")?;
         }
@@ -165,25 +120,25 @@ impl XrExercise {
     /// The solver failed (`why`; its last frame rolled back) and the scene is about to
     /// be reset: an attempt the blade touched is scored and saved as it stood, others are
     /// dropped.
-    pub fn on_solver_failure(&mut self, xr: &XrBody, why: &str) -> Result<()> {
+    pub fn on_solver_failure(&mut self, xr: &B, why: &str) -> Result<()> {
         if self.live.touched() {
             self.finish(xr, &format!("solver failed: {why}"))
         } else {
-            self.live.abort(&mut self.stroke);
+            self.live.abort::<B>(&mut self.stroke);
             Ok(())
         }
     }
 
-    fn finish(&mut self, xr: &XrBody, why: &str) -> Result<()> {
-        if self.stroke.recorder.as_ref().is_none_or(|r| r.is_empty()) {
+    fn finish(&mut self, xr: &B, why: &str) -> Result<()> {
+        if self.stroke.is_empty() {
             // The blade touched with no tracked pose recorded (cannot happen while the
             // tool follows the controller); nothing to replay: drop it.
-            self.live.abort(&mut self.stroke);
+            self.live.abort::<B>(&mut self.stroke);
             bail!("the attempt has no recorded scalpel poses");
         }
         let done = self
             .live
-            .finish(&mut self.stroke, &xr.body, &self.out_root, &self.history)?;
+            .finish(&mut self.stroke, xr, &self.out_root, &self.history)?;
         eprintln!(
             "xr: {} — {} ({})",
             done.attempt.result.summary(),
@@ -201,10 +156,9 @@ impl XrExercise {
         Ok(())
     }
 
-    /// The plan on the tissue as it is now (where not cut away).
-    pub fn lines(&self, xr: &XrBody) -> Vec<SurfaceLine> {
-        let s = xr.solver();
-        vec![self.live.decal.line_uncut(s.positions(), s.cut().live())]
+    /// The renderer the card was uploaded to was replaced: upload it again.
+    pub fn renderer_replaced(&mut self) {
+        self.card_changed |= self.card.is_some();
     }
 
     /// The card's placement (sim world) for a head at `head` (stage), uploading the card
@@ -229,5 +183,45 @@ impl XrExercise {
         };
         let aspect = card.height as f32 / card.width.max(1) as f32;
         Ok(Some(panel_transform(tray, head, aspect)))
+    }
+}
+
+impl XrExercise<Body> {
+    /// Start an attempt on `xr`, which is at its scene as loaded; pictures of the report
+    /// are rendered on `dev`.
+    pub fn start(&mut self, xr: &mut XrBody, skin: &Skin, dev: &RenderDevice) -> Result<()> {
+        self.card_changed |= self.card.take().is_some();
+        let pictures = Screenshots::new(Some(dev), xr.solver(), skin, PICTURE, Default::default())
+            .map(|s| {
+                let s = s
+                    .with_tool(xr.scalpel())
+                    .with_decal(self.live.decal.clone());
+                match xr.body {
+                    Body::Gpu(_) => s.with_shared_device(),
+                    Body::Cpu(_) => s,
+                }
+            })
+            .map_err(|e| format!("{e:#}"));
+        self.live.start(&mut self.stroke, &mut xr.body, pictures)
+    }
+
+    /// The plan on the tissue as it is now (where not cut away).
+    pub fn lines(&self, xr: &XrBody) -> Vec<SurfaceLine> {
+        let s = xr.solver();
+        vec![self.live.decal.line_uncut(s.positions(), s.cut().live())]
+    }
+}
+
+impl XrExercise<RecordedBody> {
+    /// Start an attempt on `body`, a Nakao scene as loaded; pictures of the report are
+    /// taken of its tet view offscreen.
+    pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
+        self.card_changed |= self.card.take().is_some();
+        let heat_map = incise_xr::Overlays {
+            stress: true,
+            ..Default::default()
+        };
+        let pictures = ViewPictures::new(PICTURE, heat_map).map_err(|e| format!("{e:#}"));
+        self.live.start(&mut self.stroke, body, pictures)
     }
 }

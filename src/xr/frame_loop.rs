@@ -501,7 +501,7 @@ impl<'o> Display<'_, 'o> {
         } = self;
         // An attempt the blade touched is scored and saved however the session ended.
         let saved = match exercise {
-            Some(ex) => ex.end_session(xr),
+            Some(ex) => ex.end_session(&xr.body),
             None => Ok(()),
         };
         let ended = match (ended, saved) {

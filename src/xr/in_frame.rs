@@ -14,6 +14,7 @@ use super::exercise::XrExercise;
 use super::sim_state::{Advanced, ToolCommand};
 use super::sim_step::{SimStepper, Stepped};
 use super::xr_body::XrBody;
+use crate::exercise::ToolFrame;
 
 /// Fraction of a display period the simulation may use.
 pub const SIM_BUDGET: f64 = 0.5;
@@ -93,7 +94,7 @@ impl<'s, 'x> InFrameSim<'s, 'x> {
                     done.sim_frames += 1;
                     done.tool_force = done.tool_force.max(stats.tool_force.length());
                     if let Some(ex) = exercise.as_deref_mut() {
-                        ex.after_step(&stats, pose, dt)?;
+                        ex.after_step(ToolFrame::of_xpbd(&stats), pose, dt)?;
                     }
                 }
                 Stepped::Failed(e) => {
@@ -102,7 +103,7 @@ impl<'s, 'x> InFrameSim<'s, 'x> {
                     eprintln!("xr: {e:#}; resetting the scene");
                     // An attempt the blade touched is scored and saved as it stood.
                     if let Some(ex) = exercise.as_deref_mut() {
-                        ex.on_solver_failure(self.xr, &format!("{e:#}"))?;
+                        ex.on_solver_failure(&self.xr.body, &format!("{e:#}"))?;
                     }
                     restart(self.xr, exercise, skin, dev)?;
                     break;
@@ -126,7 +127,7 @@ impl<'s, 'x> InFrameSim<'s, 'x> {
         dev: &RenderDevice,
     ) -> Result<()> {
         let reset = match exercise.as_deref_mut() {
-            Some(ex) => ex.on_a(self.xr)?,
+            Some(ex) => ex.on_a(&self.xr.body)?,
             None => true,
         };
         if reset {

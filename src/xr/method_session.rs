@@ -9,11 +9,14 @@
 //! `report.json` (the run's schema) into the output folder, and the session's frame log
 //! (`frames.csv`) and `xr_report.json` as an XPBD session does (also when it fails).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
+use glam::{Quat, Vec3};
 use incise_scalpel::HapticCurve;
+use incise_sim::contact::ToolPose;
+use incise_xr::openxr::controls::{ControllerState, commands};
 use incise_xr::openxr::haptics::haptic_pulse;
 use incise_xr::openxr::lifecycle::ExitReason;
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
@@ -21,6 +24,7 @@ use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, eye::eye_view};
 use incise_xr::{Overlays, RenderDevice, RenderSettings, Renderer};
 
+use super::exercise::XrExercise;
 use super::frame_log::{FrameLog, FrameRow};
 use super::method_stepper::Stepper;
 use super::script::{HeadsetScript, RightTrack};
@@ -28,8 +32,10 @@ use super::sim_mode::{self, SimChoice, SimMode};
 use super::simulated::SimulatedHeadset;
 use super::xr_report::{self, XrReport};
 use crate::bench::soak::percentile;
+use crate::exercise::ToolFrame;
 use crate::pictures::tet_drawing::TetDrawing;
 use crate::sim_body::ToolInput;
+use crate::sim_body::recorded::RecordedBody;
 
 /// Where a method session steps its body, and a slowdown per body frame (testing aid).
 #[derive(Debug, Clone)]
@@ -63,6 +69,39 @@ struct Session {
     given_up: f64,
     /// Why the runtime ended the session, once it has.
     exit: Option<ExitReason>,
+    /// A Nakao exercise: its plan drawn, attempts recorded from the controller and
+    /// scored on the body's cut surface (the body stepped in the frame).
+    exercise: Option<MethodExercise>,
+}
+
+/// A method session's exercise, with what it needs to reload the scene for a new attempt.
+pub struct MethodExercise {
+    /// The exercise and its attempts.
+    pub live: XrExercise<RecordedBody>,
+    /// The controllers as of the last display frame (A is acted on when pressed).
+    previous: ControllerState,
+    /// The blade's last tracked pose (held, lifted, while the controller is untracked).
+    pose: ToolPose,
+    /// Where the session writes and how its body frames are slowed: what a new attempt's
+    /// fresh body is opened with.
+    reload: (PathBuf, Duration),
+}
+
+impl MethodExercise {
+    /// Open the exercise at `path`, attempts saved under `out_root` and appended to
+    /// `history`.
+    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<MethodExercise> {
+        Ok(MethodExercise {
+            live: XrExercise::open(path, out_root, history)?,
+            previous: ControllerState::default(),
+            // Out of reach until the controller is tracked.
+            pose: ToolPose {
+                position: Vec3::new(0.0, 0.0, 1.0),
+                rotation: Quat::IDENTITY,
+            },
+            reload: (PathBuf::new(), Duration::ZERO),
+        })
+    }
 }
 
 /// Run `scene` (any method but XPBD) on the simulated headset playing `script_path`,
@@ -73,9 +112,10 @@ pub fn run_simulated(
     script_path: &Path,
     out: &Path,
     sim: &MethodSim,
+    exercise: Option<MethodExercise>,
 ) -> Result<String> {
     let script = HeadsetScript::load(script_path)?;
-    let (mode, why) = sim_mode::resolve(sim.choice, false, !script.realtime)?;
+    let (mode, why) = sim_mode::resolve(sim.choice, exercise.is_some(), !script.realtime)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let (stepper, drawing) = Stepper::open(scene, out, mode, sim.slow)?;
     let tray = tray_for(&drawing);
@@ -86,7 +126,7 @@ pub fn run_simulated(
     run_on(
         &mut headset,
         scene,
-        (stepper, drawing),
+        (stepper, drawing, exercise),
         tray,
         out,
         (mode, why),
@@ -102,11 +142,13 @@ pub fn run_on_runtime(
     scene: &Path,
     out: &Path,
     sim: &MethodSim,
+    exercise: Option<MethodExercise>,
 ) -> Result<String> {
-    let (mode, why) = sim_mode::resolve(sim.choice, false, false)?;
+    let (mode, why) = sim_mode::resolve(sim.choice, exercise.is_some(), false)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let opened = Stepper::open(scene, out, mode, sim.slow)?;
-    let tray = tray_for(&opened.1);
+    let (stepper, drawing) = Stepper::open(scene, out, mode, sim.slow)?;
+    let tray = tray_for(&drawing);
+    let opened = (stepper, drawing, exercise);
     run_on(headset, scene, opened, tray, out, (mode, why), sim)
 }
 
@@ -124,7 +166,7 @@ fn tray_for(drawing: &TetDrawing) -> Tray {
 fn run_on(
     headset: &mut dyn Headset,
     scene: &Path,
-    (stepper, drawing): (Stepper, TetDrawing),
+    (stepper, drawing, exercise): (Stepper, TetDrawing, Option<MethodExercise>),
     tray: Tray,
     out: &Path,
     (mode, why): (SimMode, String),
@@ -145,7 +187,12 @@ fn run_on(
         log: FrameLog::default(),
         given_up: 0.0,
         exit: None,
+        exercise,
     };
+    if let Some(ex) = &mut s.exercise {
+        ex.reload = (out.to_path_buf(), sim.slow);
+    }
+    s.start_attempt()?;
     let started = Instant::now();
     let ended = s.run(headset, &dev, sim.frames);
     let wall_s = started.elapsed().as_secs_f64();
@@ -180,6 +227,52 @@ fn tool_stroke(script: &HeadsetScript, path: &Path) -> Result<Option<incise_scal
 }
 
 impl Session {
+    /// An exercise's attempt on the body as loaded (frame 0).
+    fn start_attempt(&mut self) -> Result<()> {
+        let Some(ex) = &mut self.exercise else {
+            return Ok(());
+        };
+        let Stepper::InFrame { body, .. } = &mut self.stepper else {
+            bail!("exercise sessions step the body in the frame loop (--sim in-frame)");
+        };
+        ex.live.start(body)
+    }
+
+    /// A pressed in an exercise: an attempt the blade touched is finished (its card
+    /// shown); otherwise the scene is loaded afresh and a new attempt starts.
+    fn on_a(&mut self, headset: &dyn Headset, dev: &RenderDevice) -> Result<()> {
+        let (Some(ex), Stepper::InFrame { body, .. }) = (&mut self.exercise, &self.stepper) else {
+            return Ok(());
+        };
+        if !ex.live.on_a(body)? {
+            return Ok(());
+        }
+        let scene = ex.live.exercise().scene_path.clone();
+        let (out, slow) = ex.reload.clone();
+        (self.stepper, self.drawing) = Stepper::open(&scene, &out, SimMode::InFrame, slow)?;
+        self.renderer = renderer_for(dev, headset.format(), &self.drawing);
+        ex.live.renderer_replaced();
+        // The fresh body's time 0 is the next display frame's.
+        (self.start, self.given_up) = (None, 0.0);
+        self.start_attempt()
+    }
+
+    /// Keep body frame `b` for the attempt under way, stepped with `tool` (its pose
+    /// recorded when the controller tracked it: `tracked`).
+    fn keep(
+        ex: &mut MethodExercise,
+        b: &RecordedBody,
+        tool: &ToolInput,
+        tracked: bool,
+    ) -> Result<()> {
+        let (Some(frame), ToolInput::Hand { pose, .. }) = (b.last_frame(), tool) else {
+            return Ok(());
+        };
+        let pose = tracked.then_some(*pose);
+        ex.live
+            .after_step(ToolFrame::of(frame), pose, b.body.frame_dt())
+    }
+
     /// Display frames until the session ends, asking the runtime to end it after
     /// `max_frames`.
     fn run(
@@ -218,13 +311,17 @@ impl Session {
     /// frames stepped, their rate over `wall_s` and how the session ended) into `out`,
     /// also on a failure; the report and the body's summary line.
     fn close(
-        self,
+        mut self,
         ended: Result<()>,
         mut report: XrReport,
         wall_s: f64,
         out: &Path,
     ) -> Result<(XrReport, String)> {
-        let closed = ended.and_then(|()| self.stepper.close(out));
+        let saved = match (&mut self.exercise, &self.stepper) {
+            (Some(ex), Stepper::InFrame { body, .. }) => ex.live.end_session(body),
+            _ => Ok(()),
+        };
+        let closed = ended.and(saved).and_then(|()| self.stepper.close(out));
         if let Ok((_, frames)) = &closed {
             report.sim_frames = *frames as u64;
         }
@@ -270,6 +367,12 @@ impl Session {
             haptic_stops: self.stops,
             dropped_time_s: self.given_up,
             slow_sim_ms: slow.as_millis() as u64,
+            exercise: (self.exercise.as_ref())
+                .map(|e| e.live.exercise().path.display().to_string()),
+            attempts: self
+                .exercise
+                .as_ref()
+                .map_or(Vec::new(), |e| e.live.attempts.clone()),
             ..XrReport::new(method, &self.log, headset)
         })
     }
@@ -283,17 +386,34 @@ impl Session {
         f: &HeadsetFrame,
     ) -> Result<()> {
         let started = Instant::now();
+        if let Some(ex) = &mut self.exercise {
+            let pressed = commands(&ex.previous, &f.controllers);
+            ex.previous = f.controllers;
+            if pressed.reset {
+                self.on_a(headset, dev)?;
+            }
+        }
         let start = *self.start.get_or_insert(f.display_time);
         let tool = self.tool(f);
         let stamp = (self.log.rows.len() as u64, f.display_time);
         let until = f.display_time - start - self.given_up;
-        let step = self.stepper.advance(tool, until, stamp)?;
+        let tracked = f.controllers.right_grip.is_some();
+        let ex = &mut self.exercise;
+        let step = self
+            .stepper
+            .advance(tool, until, stamp, &mut |b| match ex {
+                Some(ex) => Session::keep(ex, b, &tool, tracked),
+                None => Ok(()),
+            })?;
         self.given_up += step.given_up;
         if let Some(view) = step.view
             && self.drawing.update(view)?
         {
-            // The topology changed.
+            // The topology changed (the new renderer needs the card again).
             self.renderer = renderer_for(dev, headset.format(), &self.drawing);
+            if let Some(ex) = &mut self.exercise {
+                ex.live.renderer_replaced();
+            }
         }
         let adv = step.done;
         let haptic = self.vibrate(headset, adv.tool_force, f.display_period)?;
@@ -351,6 +471,15 @@ impl Session {
             .eyes
             .map(|(pose, fov)| eye_view(pose, fov, stage_from_sim));
         let (background, background_alpha) = headset.backdrop().clear();
+        let (lines, panel) = match &mut self.exercise {
+            Some(ex) => {
+                let head = (f.eyes[0].0.position + f.eyes[1].0.position) * 0.5;
+                let panel = ex.live.panel(&mut self.renderer, dev, &self.tray, head)?;
+                let line = ex.live.decal().line(self.drawing.state().positions);
+                (vec![line], panel)
+            }
+            None => (Vec::new(), None),
+        };
         let settings = RenderSettings {
             overlays: Overlays {
                 stress: true,
@@ -359,6 +488,8 @@ impl Session {
             stress_max: self.drawing.scale,
             background,
             background_alpha,
+            lines,
+            panel,
             ..RenderSettings::default()
         };
         let mut enc = dev
@@ -381,6 +512,18 @@ impl Session {
     fn tool(&mut self, f: &HeadsetFrame) -> ToolInput {
         let c = f.controllers;
         self.hand |= c.blade_engaged() && c.right_grip.is_some();
+        if let Some(ex) = &mut self.exercise {
+            // An exercise's blade is the controller's from the start (the scene's scripted
+            // cut must not open the tissue), held where it was while untracked.
+            self.hand = true;
+            if let Some(grip) = c.right_grip {
+                ex.pose = scalpel_pose(grip, BladeOffset::default(), &self.tray);
+            }
+            return ToolInput::Hand {
+                pose: ex.pose,
+                engaged: c.blade_engaged() && c.right_grip.is_some(),
+            };
+        }
         match (self.hand, c.right_grip) {
             (true, Some(grip)) => ToolInput::Hand {
                 pose: scalpel_pose(grip, BladeOffset::default(), &self.tray),

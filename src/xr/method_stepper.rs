@@ -91,8 +91,14 @@ impl Stepper {
     }
 
     /// Step the body, or hand its thread the frame's command (`stamp`), up to simulated
-    /// time `until` with `tool`.
-    pub fn advance(&mut self, tool: ToolInput, until: f64, stamp: CommandStamp) -> Result<Step> {
+    /// time `until` with `tool`; in the frame, `after` sees the body after each frame.
+    pub fn advance(
+        &mut self,
+        tool: ToolInput,
+        until: f64,
+        stamp: CommandStamp,
+        after: &mut dyn FnMut(&RecordedBody) -> Result<()>,
+    ) -> Result<Step> {
         let started = Instant::now();
         match self {
             Stepper::InFrame { body, slow, last } => {
@@ -100,6 +106,7 @@ impl Stepper {
                 let mut stepped = 0;
                 while body.body.time() + 0.5 * dt < until && stepped < MAX_CATCH_UP {
                     body.step(&tool).map_err(anyhow::Error::msg)?;
+                    after(body)?;
                     std::thread::sleep(*slow);
                     stepped += 1;
                 }

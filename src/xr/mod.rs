@@ -78,30 +78,43 @@ pub struct XrOptions {
 }
 
 /// Run `incise xr`; the session's summary line. A scene of another method than XPBD runs
-/// a [`method_session`] (no exercise). No usable runtime: an [`XrUnavailable`] error
-/// (exit 2).
+/// a [`method_session`] (a Nakao scene's exercise too). No usable runtime: an
+/// [`XrUnavailable`] error (exit 2).
 pub fn run(opts: &XrOptions) -> Result<String> {
-    if opts.exercise.is_none() {
-        let scene = crate::scene::load_scene(&opts.scene)?;
-        if !matches!(scene.model, crate::scene::ModelChoice::Xpbd) {
-            return run_method(opts);
-        }
+    let exercise = opts
+        .exercise
+        .as_ref()
+        .map(|p| crate::exercise::load_exercise(p))
+        .transpose()?;
+    let scene = match &exercise {
+        Some(e) => e.scene.model.method(),
+        None => crate::scene::load_scene(&opts.scene)?.model.method(),
+    };
+    if scene != crate::sim_body::Method::Xpbd {
+        return run_method(opts, exercise.map(|e| e.scene_path));
     }
     run_xpbd(opts).map(|r| r.summary())
 }
 
-/// `incise xr` for a Nakao or rheology scene, on the simulated headset or the runtime's.
-fn run_method(opts: &XrOptions) -> Result<String> {
+/// `incise xr` for a Nakao or rheology scene (`exercise_scene`: the scene of a Nakao
+/// exercise), on the simulated headset or the runtime's.
+fn run_method(opts: &XrOptions, exercise_scene: Option<PathBuf>) -> Result<String> {
+    let exercise = opts
+        .exercise
+        .as_ref()
+        .map(|p| method_session::MethodExercise::open(p, &opts.out.join("attempts"), &opts.history))
+        .transpose()?;
+    let scene = exercise_scene.unwrap_or_else(|| opts.scene.clone());
     let sim = method_session::MethodSim {
         choice: opts.sim,
         slow: Duration::from_millis(opts.slow_sim_ms),
         frames: opts.frames,
     };
     if let Some(script) = &opts.simulated {
-        return method_session::run_simulated(&opts.scene, script, &opts.out, &sim);
+        return method_session::run_simulated(&scene, script, &opts.out, &sim, exercise);
     }
-    let mut session = open_session(&opts.scene)?;
-    method_session::run_on_runtime(&mut session, &opts.scene, &opts.out, &sim)
+    let mut session = open_session(&scene)?;
+    method_session::run_on_runtime(&mut session, &scene, &opts.out, &sim, exercise)
 }
 
 /// The OpenXR session, or [`XrUnavailable`] naming what is missing.
