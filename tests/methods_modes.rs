@@ -451,3 +451,27 @@ fn every_shipped_scene_opens_in_the_preview_and_on_the_headset() {
         }
     }
 }
+
+/// The options only an XPBD headset session uses are refused for a Nakao scene, naming
+/// the option, instead of being ignored.
+#[test]
+fn a_method_headset_session_refuses_the_xpbd_only_options() {
+    let dir = temp_dir("modes-xr-refused");
+    let s = script(&dir, 0.2, "");
+    let stroke =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("config/strokes/plate_line_nakao_reference.ron");
+    for (extra, named) in [
+        (vec!["--stroke", stroke.to_str().unwrap()], "--stroke"),
+        (vec!["--record-stroke", "x.ron"], "--record-stroke"),
+        (vec!["--device", "gpu"], "--device gpu"),
+        (vec!["--inject-nan-at", "3"], "--inject-nan-at"),
+    ] {
+        let o = run_xr("config/plate_cut_nakao.ron", &s, &dir.join("out"), &extra);
+        let err = text(&o.stderr);
+        assert!(!o.status.success(), "{extra:?} was accepted");
+        assert!(
+            err.contains(&format!("{named} is for XPBD scenes")),
+            "{err}"
+        );
+    }
+}

@@ -177,30 +177,38 @@ wait $P"#,
     assert!(cut > 200, "no cut surface after the drag ({cut} pixels)");
 }
 
-#[test]
-fn an_exercise_draws_its_plan_on_the_tissue() {
-    let Some(img) = preview_screenshot(
-        "xvfb-exercise",
-        &[
-            "--exercise",
-            "config/exercises/slab_depth.ron",
-            "--frames",
-            "10",
-            "--size",
-            "900x600",
-        ],
-    ) else {
-        return;
-    };
-    // The violet marker line (blue well above green, red between) in the 3D view, right
-    // of the panel: a 3 cm line 1 mm wide.
-    let violet = (0..img.height)
+/// The window of `exercise` after 10 frames, 900 × 600 (`name`: its temporary folder).
+fn exercise_window(name: &str, exercise: &str) -> Option<RgbaImage> {
+    let args = [
+        "--exercise",
+        exercise,
+        "--frames",
+        "10",
+        "--size",
+        "900x600",
+    ];
+    preview_screenshot(name, &args)
+}
+
+/// Pixels of the violet marker line (blue well above green, red between) in the 3D view,
+/// right of the panel.
+fn plan_pixels(img: &RgbaImage) -> usize {
+    (0..img.height)
         .flat_map(|y| (300..img.width).map(move |x| (x, y)))
         .filter(|&(x, y)| {
             let p = img.get(x, y);
             p[2] as i32 > p[1] as i32 + 60 && p[0] as i32 > p[1] as i32 + 20
         })
-        .count();
+        .count()
+}
+
+#[test]
+fn an_exercise_draws_its_plan_on_the_tissue() {
+    let Some(img) = exercise_window("xvfb-exercise", "config/exercises/slab_depth.ron") else {
+        return;
+    };
+    // A 3 cm line 1 mm wide.
+    let violet = plan_pixels(&img);
     eprintln!("{violet} violet pixels");
     assert!(
         (60..5000).contains(&violet),
@@ -212,26 +220,13 @@ fn an_exercise_draws_its_plan_on_the_tissue() {
 /// panel offers its attempts): the same violet line as an XPBD exercise's.
 #[test]
 fn a_nakao_exercise_draws_its_plan_in_the_method_window() {
-    let Some(img) = preview_screenshot(
+    let Some(img) = exercise_window(
         "xvfb-exercise-nakao",
-        &[
-            "--exercise",
-            "config/exercises/plate_line_nakao.ron",
-            "--frames",
-            "10",
-            "--size",
-            "900x600",
-        ],
+        "config/exercises/plate_line_nakao.ron",
     ) else {
         return;
     };
-    let violet = (0..img.height)
-        .flat_map(|y| (300..img.width).map(move |x| (x, y)))
-        .filter(|&(x, y)| {
-            let p = img.get(x, y);
-            p[2] as i32 > p[1] as i32 + 60 && p[0] as i32 > p[1] as i32 + 20
-        })
-        .count();
+    let violet = plan_pixels(&img);
     eprintln!("{violet} violet pixels");
     assert!(
         (60..5000).contains(&violet),

@@ -24,7 +24,7 @@ pub mod xr_report;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use incise_scalpel::HapticCurve;
 use incise_xr::RenderDevice;
 use incise_xr::openxr::scalpel_pose::BladeOffset;
@@ -105,6 +105,7 @@ fn run_method(opts: &XrOptions, exercise_scene: Option<PathBuf>) -> Result<Strin
         .map(|p| method_session::MethodExercise::open(p, &opts.out.join("attempts"), &opts.history))
         .transpose()?;
     let scene = exercise_scene.unwrap_or_else(|| opts.scene.clone());
+    refuse_xpbd_options(opts, &scene)?;
     let sim = method_session::MethodSim {
         choice: opts.sim,
         slow: Duration::from_millis(opts.slow_sim_ms),
@@ -115,6 +116,26 @@ fn run_method(opts: &XrOptions, exercise_scene: Option<PathBuf>) -> Result<Strin
     }
     let mut session = open_session(&scene)?;
     method_session::run_on_runtime(&mut session, &scene, &opts.out, &sim, exercise)
+}
+
+/// The options only an XPBD session uses, refused for a method session's `scene` (naming
+/// the option) rather than ignored.
+fn refuse_xpbd_options(opts: &XrOptions, scene: &Path) -> Result<()> {
+    let given = [
+        (opts.stroke.is_some(), "--stroke"),
+        (opts.record_stroke.is_some(), "--record-stroke"),
+        (opts.device == DeviceChoice::Gpu, "--device gpu"),
+        (opts.inject_nan_at.is_some(), "--inject-nan-at"),
+        (opts.inject_sim_panic_at.is_some(), "--inject-sim-panic-at"),
+    ];
+    match given.iter().find(|(on, _)| *on) {
+        Some((_, flag)) => bail!(
+            "{}: {flag} is for XPBD scenes; this scene's body runs on the CPU and its tool \
+             follows the scene's script or the right controller",
+            scene.display()
+        ),
+        None => Ok(()),
+    }
 }
 
 /// The OpenXR session, or [`XrUnavailable`] naming what is missing.
