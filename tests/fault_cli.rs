@@ -145,10 +145,32 @@ fn ctrl_c_stops_a_run_keeping_its_report_and_stroke() {
 }
 
 /// Ctrl-C during `incise xr` ends the session through the runtime's shutdown
-/// (xrRequestExitSession): exit 0, the report and frame log written.
+/// (xrRequestExitSession): exit 130, the report and frame log written; for an XPBD scene
+/// and for a Nakao one (its method session, which also writes the body's report.json).
 #[test]
 fn ctrl_c_ends_an_xr_session_cleanly() {
-    let dir = temp_dir("ctrl-c-xr");
+    for (name, scene) in [
+        ("ctrl-c-xr", "config/plate_cut.ron"),
+        ("ctrl-c-xr-nakao", "config/plate_cut_nakao.ron"),
+    ] {
+        let out = xr_interrupted(name, scene);
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("xr_report.json")).unwrap())
+                .unwrap();
+        assert_eq!(r["exit"], "Interrupted", "{scene}: {r}");
+        let frames = r["frames"].as_u64().unwrap();
+        assert!(frames < 60 * 72, "{scene} stopped early: {frames} frames");
+        assert!(out.join("frames.csv").exists(), "{scene}");
+        if scene.ends_with("nakao.ron") {
+            assert!(out.join("report.json").exists(), "the body's report");
+        }
+    }
+}
+
+/// `incise xr SCENE` on a 60 s simulated headset, Ctrl-C after 5 s; it must exit 130
+/// saying so. Its output folder.
+fn xr_interrupted(name: &str, scene: &str) -> std::path::PathBuf {
+    let dir = temp_dir(name);
     let script = dir.join("headset.ron");
     // Long enough (60 s of display time) never to finish on its own before the signal.
     std::fs::write(
@@ -160,7 +182,7 @@ fn ctrl_c_ends_an_xr_session_cleanly() {
     let out = dir.join("out");
     let child = common::incise_command(&[
         "xr",
-        "config/plate_cut.ron",
+        scene,
         "--simulated-headset",
         script.to_str().unwrap(),
         "--out",
@@ -174,12 +196,6 @@ fn ctrl_c_ends_an_xr_session_cleanly() {
     let o = child.wait_with_output().unwrap();
     let err = text(&o.stderr);
     // An interrupt says so and uses the interrupted exit code, like `incise run` (issue 19).
-    assert_eq!(o.status.code(), Some(130), "{err}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("xr_report.json")).unwrap())
-            .unwrap();
-    assert_eq!(r["exit"], "Interrupted", "{r}");
-    let frames = r["frames"].as_u64().unwrap();
-    assert!(frames < 60 * 72, "stopped early: {frames} frames");
-    assert!(out.join("frames.csv").exists());
+    assert_eq!(o.status.code(), Some(130), "{scene}: {err}");
+    out
 }

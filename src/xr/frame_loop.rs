@@ -33,7 +33,7 @@ use super::xr_body::XrBody;
 
 /// `Idle` answers in a row after which the loop gives up (about 10 s of a runtime that
 /// never makes the session ready).
-const MAX_IDLE: u32 = 1000;
+pub const MAX_IDLE: u32 = 1000;
 
 /// How the loop runs.
 pub struct LoopOptions<'a> {

@@ -26,6 +26,7 @@ use incise_xr::{Overlays, RenderDevice, RenderSettings, Renderer};
 
 use super::exercise::XrExercise;
 use super::frame_log::{FrameLog, FrameRow};
+use super::frame_loop::MAX_IDLE;
 use super::method_stepper::Stepper;
 use super::script::{HeadsetScript, RightTrack};
 use super::sim_mode::{self, SimChoice, SimMode};
@@ -69,6 +70,8 @@ struct Session {
     given_up: f64,
     /// Why the runtime ended the session, once it has.
     exit: Option<ExitReason>,
+    /// Whether Ctrl-C asked the session to end.
+    interrupted: bool,
     /// A Nakao exercise: its plan drawn, attempts recorded from the controller and
     /// scored on the body's cut surface (the body stepped in the frame).
     exercise: Option<MethodExercise>,
@@ -187,6 +190,7 @@ fn run_on(
         log: FrameLog::default(),
         given_up: 0.0,
         exit: None,
+        interrupted: false,
         exercise,
     };
     if let Some(ex) = &mut s.exercise {
@@ -274,7 +278,8 @@ impl Session {
     }
 
     /// Display frames until the session ends, asking the runtime to end it after
-    /// `max_frames`.
+    /// `max_frames` or on Ctrl-C (as the XPBD loop does, so the files are saved as after
+    /// any other end).
     fn run(
         &mut self,
         headset: &mut dyn Headset,
@@ -282,28 +287,49 @@ impl Session {
         max_frames: Option<u64>,
     ) -> Result<()> {
         let mut exit_asked = false;
-        while let Some(frame) = self.next(headset)? {
+        while let Some(frame) = self.next(headset, &mut exit_asked)? {
             self.frame(headset, dev, &frame)?;
-            if !exit_asked && max_frames.is_some_and(|m| self.log.rows.len() as u64 >= m) {
-                headset.request_exit()?;
-                exit_asked = true;
-            }
+            let limit = max_frames.is_some_and(|m| self.log.rows.len() as u64 >= m);
+            self.maybe_exit(headset, &mut exit_asked, limit)?;
         }
         Ok(())
     }
 
-    /// The next begun frame, `None` when the session has ended (the runtime's reason kept).
-    fn next(&mut self, headset: &mut dyn Headset) -> Result<Option<HeadsetFrame>> {
-        loop {
+    /// Ask the runtime to end the session once: on Ctrl-C, or when `limit` is reached.
+    fn maybe_exit(
+        &mut self,
+        headset: &mut dyn Headset,
+        asked: &mut bool,
+        limit: bool,
+    ) -> Result<()> {
+        let interrupted = crate::interrupt::requested();
+        if !*asked && (interrupted || limit) {
+            *asked = true;
+            self.interrupted = interrupted;
+            headset.request_exit()?;
+        }
+        Ok(())
+    }
+
+    /// The next begun frame, `None` when the session has ended (the runtime's reason kept)
+    /// or the runtime answered Idle [`MAX_IDLE`] times in a row.
+    fn next(
+        &mut self,
+        headset: &mut dyn Headset,
+        asked: &mut bool,
+    ) -> Result<Option<HeadsetFrame>> {
+        for _ in 0..=MAX_IDLE {
             match headset.next_frame()? {
                 FrameEvent::Frame(f) => return Ok(Some(*f)),
-                FrameEvent::Idle => continue,
+                // Ctrl-C before the runtime runs the session ends it at once.
+                FrameEvent::Idle => self.maybe_exit(headset, asked, false)?,
                 FrameEvent::Ended(why) => {
                     self.exit = Some(why);
                     return Ok(None);
                 }
             }
         }
+        Ok(None)
     }
 
     /// Close the body after the session `ended` (its `report.json` written unless the
@@ -328,10 +354,17 @@ impl Session {
         if wall_s > 0.0 {
             report.sim_steps_per_s = report.sim_frames as f64 / wall_s;
         }
-        report.exit = xr_report::exit_text(closed.as_ref().err(), false, self.exit);
+        report.exit = xr_report::exit_text(closed.as_ref().err(), self.interrupted, self.exit);
         report.save(&self.log, out)?;
         let kept = "the frame log and xr_report.json";
         match closed {
+            // Ctrl-C: the session ended cleanly, but the run was cut short (exit 130).
+            Ok(_) if self.interrupted => Err(crate::interrupt::Interrupted {
+                what: format!("the XR session on {}", report.scene),
+                frames: report.frames,
+                out: out.display().to_string(),
+            }
+            .into()),
             Ok((summary, _)) => Ok((report, summary)),
             Err(e) => Err(xr_report::failed(e, report.frames, kept, out)),
         }
