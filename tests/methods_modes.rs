@@ -255,7 +255,11 @@ fn nakao_headset_cuts_by_its_stroke_and_by_the_controller_with_its_own_force() {
         rows.iter()
             .all(|f| f["engaged"] == 0.0 && f["haptic"] == 0.0)
     );
-    assert_eq!(x["haptic_pulses"], 0, "{x}");
+    assert_eq!(
+        (x["haptic_pulses"].as_u64(), x["haptic_stops"].as_u64()),
+        (Some(0), Some(0)),
+        "{x}"
+    );
     assert_eq!(x["exit"], "Exited", "{x}");
     assert!(
         x["released_tets"].is_null() && x["substeps"].is_null(),
@@ -288,6 +292,14 @@ fn nakao_headset_cuts_by_its_stroke_and_by_the_controller_with_its_own_force() {
     assert_eq!(x["haptic_pulses"].as_f64().unwrap(), pulses, "{x}");
     let vibrated = rows.iter().filter(|f| f["haptic"] > 0.0).count();
     assert_eq!(vibrated as f64, pulses, "{x}");
+    // One stop each time the vibration ends (as XPBD's sessions), not one a still frame.
+    let stops = x["haptic_stops"].as_u64().unwrap() as usize;
+    let endings = rows
+        .windows(2)
+        .filter(|w| w[0]["haptic"] > 0.0 && w[1]["haptic"] == 0.0)
+        .count()
+        + usize::from(rows.last().is_some_and(|f| f["haptic"] > 0.0));
+    assert_eq!(stops, endings, "{x}");
     let cutting = rows
         .iter()
         .filter(|f| f["engaged"] == 1.0 && f["tool_force_n"] > 0.05)

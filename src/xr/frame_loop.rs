@@ -358,15 +358,9 @@ impl<'o> Display<'_, 'o> {
     fn vibrate(&mut self, force: f32, engaged: bool, period: f64) -> Result<f32> {
         let amplitude = (self.opts.haptic)(force);
         let pulse = haptic_pulse(amplitude, engaged, period);
-        match self.haptics.next(pulse) {
-            HapticCall::Apply(p) => {
-                self.headset.vibrate(Some(p))?;
-                self.out.haptic_pulses += 1;
-            }
-            HapticCall::Stop => {
-                self.headset.vibrate(None)?;
-                self.out.haptic_stops += 1;
-            }
+        match self.haptics.send(pulse, |p| self.headset.vibrate(p))? {
+            HapticCall::Apply(_) => self.out.haptic_pulses += 1,
+            HapticCall::Stop => self.out.haptic_stops += 1,
             HapticCall::Nothing => {}
         }
         let sent = pulse.map_or(0.0, |p| p.amplitude);

@@ -17,7 +17,7 @@ use glam::{Quat, Vec3};
 use incise_scalpel::HapticCurve;
 use incise_sim::contact::ToolPose;
 use incise_xr::openxr::controls::{ControllerState, commands};
-use incise_xr::openxr::haptics::haptic_pulse;
+use incise_xr::openxr::haptics::{HapticCall, HapticGate, haptic_pulse};
 use incise_xr::openxr::lifecycle::ExitReason;
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
 use incise_xr::openxr::tray::Tray;
@@ -61,9 +61,11 @@ struct Session {
     start: Option<f64>,
     /// Vibration pulses sent.
     pulses: u64,
-    /// Vibration stops sent (every display frame without a pulse).
+    /// Vibration stops sent (once each time the blade stopped vibrating).
     stops: u64,
     haptic: HapticCurve,
+    /// Whether the controller is vibrating (a stop is sent once when it should stop).
+    gate: HapticGate,
     /// One row per display frame.
     log: FrameLog,
     /// Simulated time given up by an in-frame body slower than real time, s.
@@ -187,6 +189,7 @@ fn run_on(
         pulses: 0,
         stops: 0,
         haptic: HapticCurve::default(),
+        gate: HapticGate::default(),
         log: FrameLog::default(),
         given_up: 0.0,
         exit: None,
@@ -199,6 +202,10 @@ fn run_on(
     s.start_attempt()?;
     let started = Instant::now();
     let ended = s.run(headset, &dev, sim.frames);
+    // The controller may be gone with the session: stopping its vibration can fail.
+    if s.gate.vibrating() && headset.vibrate(None).is_ok() {
+        s.stops += 1;
+    }
     let wall_s = started.elapsed().as_secs_f64();
     let report = s.report(headset, scene, (mode, why.clone()), sim.slow)?;
     let (p50, p95) = s.work_p50_p95();
@@ -483,11 +490,11 @@ impl Session {
     /// amplitude sent.
     fn vibrate(&mut self, headset: &mut dyn Headset, force: f32, period: f64) -> Result<f32> {
         let pulse = haptic_pulse(self.haptic.amplitude(force), self.hand, period);
-        match pulse {
-            Some(_) => self.pulses += 1,
-            None => self.stops += 1,
+        match self.gate.send(pulse, |p| headset.vibrate(p))? {
+            HapticCall::Apply(_) => self.pulses += 1,
+            HapticCall::Stop => self.stops += 1,
+            HapticCall::Nothing => {}
         }
-        headset.vibrate(pulse)?;
         Ok(pulse.map_or(0.0, |p| p.amplitude))
     }
 

@@ -68,6 +68,22 @@ impl HapticGate {
         }
     }
 
+    /// Make this frame's call for `pulse` through `vibrate` (the pulse, the one stop after
+    /// the last, or nothing); the call made.
+    pub fn send<E>(
+        &mut self,
+        pulse: Option<HapticPulse>,
+        vibrate: impl FnOnce(Option<HapticPulse>) -> Result<(), E>,
+    ) -> Result<HapticCall, E> {
+        let call = self.next(pulse);
+        match call {
+            HapticCall::Apply(p) => vibrate(Some(p))?,
+            HapticCall::Stop => vibrate(None)?,
+            HapticCall::Nothing => {}
+        }
+        Ok(call)
+    }
+
     /// Whether the last call left the controller vibrating (a stop is due at the end).
     pub fn vibrating(&self) -> bool {
         self.vibrating
