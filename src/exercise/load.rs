@@ -28,26 +28,16 @@ pub struct LoadedExercise {
 }
 
 /// Read, validate and place an exercise: its fields, its scene (an XPBD scene with a
-/// scalpel, or a Nakao scene, whose blade a stroke file drives) and its plan (every point within `surface_tolerance` of the organ's surface).
+/// scalpel, or a Nakao scene, whose blade a stroke file drives) and its plan (every point
+/// within `surface_tolerance` of the organ's surface).
 pub fn load_exercise(path: &Path) -> Result<LoadedExercise> {
-    let text = ron_file::read(path).map_err(SceneError::from)?;
-    let exercise = parse_exercise(&text, path)?;
+    let (text, exercise, scene_path) = read_exercise(path)?;
     let value_err = |field: &str, line: usize, msg: String| SceneError::Value {
         path: path.into(),
         line,
         field: field.into(),
         msg,
     };
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let scene_path = dir.join(&exercise.scene);
-    if !scene_path.is_file() {
-        return Err(value_err(
-            "scene",
-            locate(&text, "scene"),
-            format!("names {}, which is not a file", scene_path.display()),
-        )
-        .into());
-    }
     let scene = load_scene(&scene_path).with_context(|| format!("{}: scene", path.display()))?;
     if let ModelChoice::Rheology(_) = scene.model {
         return Err(value_err(
@@ -100,6 +90,31 @@ pub fn load_exercise(path: &Path) -> Result<LoadedExercise> {
         mesh,
         plan,
     })
+}
+
+/// The scene file the exercise at `path` names, from its text alone (no mesh is built):
+/// what a command needs to pick the session for the scene's method.
+pub fn exercise_scene(path: &Path) -> Result<PathBuf> {
+    Ok(read_exercise(path)?.2)
+}
+
+/// The exercise file's text, its checked fields and the scene file it names (which must
+/// exist).
+fn read_exercise(path: &Path) -> Result<(String, Exercise, PathBuf)> {
+    let text = ron_file::read(path).map_err(SceneError::from)?;
+    let exercise = parse_exercise(&text, path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let scene_path = dir.join(&exercise.scene);
+    if !scene_path.is_file() {
+        return Err(SceneError::Value {
+            path: path.into(),
+            line: locate(&text, "scene"),
+            field: "scene".into(),
+            msg: format!("names {}, which is not a file", scene_path.display()),
+        }
+        .into());
+    }
+    Ok((text, exercise, scene_path))
 }
 
 /// Parse exercise text and check every value's range; `path` names it in errors.

@@ -26,7 +26,7 @@ pub use history::{
     HistoryEntry, append as append_history, read as read_history, table as history_table, utc_now,
 };
 pub use live::{AttemptBody, Finished, LiveExercise, StrokeSource};
-pub use load::{LoadedExercise, load_exercise, parse_exercise};
+pub use load::{LoadedExercise, exercise_scene, load_exercise, parse_exercise};
 pub use metrics::{Metrics, STROKE_GAP_FRAMES, ToolFrame, compute as compute_metrics};
 pub use model::{Exercise, PassThresholds, Tolerance};
 pub use plan::{Plan, PlanCoords, PlanSample, RestSurface};

@@ -68,7 +68,7 @@ pub fn run(opts: PreviewOptions) -> Result<()> {
         bail!("{why}: the preview needs a window; use `incise run` or `incise render` headless");
     }
     let scene = match &opts.exercise {
-        Some(e) => crate::exercise::load_exercise(e)?.scene_path,
+        Some(e) => crate::exercise::exercise_scene(e)?,
         None => opts.scene.clone(),
     };
     if !is_xpbd(&scene)? {

@@ -366,12 +366,9 @@ impl Session {
         let kept = "the frame log and xr_report.json";
         match closed {
             // Ctrl-C: the session ended cleanly, but the run was cut short (exit 130).
-            Ok(_) if self.interrupted => Err(crate::interrupt::Interrupted {
-                what: format!("the XR session on {}", report.scene),
-                frames: report.frames,
-                out: out.display().to_string(),
+            Ok(_) if self.interrupted => {
+                Err(xr_report::interrupted(&report.scene, report.frames, out))
             }
-            .into()),
             Ok((summary, _)) => Ok((report, summary)),
             Err(e) => Err(xr_report::failed(e, report.frames, kept, out)),
         }

@@ -81,41 +81,35 @@ pub struct XrOptions {
 /// a [`method_session`] (a Nakao scene's exercise too). No usable runtime: an
 /// [`XrUnavailable`] error (exit 2).
 pub fn run(opts: &XrOptions) -> Result<String> {
-    let exercise = opts
-        .exercise
-        .as_ref()
-        .map(|p| crate::exercise::load_exercise(p))
-        .transpose()?;
-    let scene = match &exercise {
-        Some(e) => e.scene.model.method(),
-        None => crate::scene::load_scene(&opts.scene)?.model.method(),
+    let scene = match &opts.exercise {
+        Some(e) => crate::exercise::exercise_scene(e)?,
+        None => opts.scene.clone(),
     };
-    if scene != crate::sim_body::Method::Xpbd {
-        return run_method(opts, exercise.map(|e| e.scene_path));
+    if crate::scene::load_scene(&scene)?.model.method() != Method::Xpbd {
+        return run_method(opts, &scene);
     }
     run_xpbd(opts).map(|r| r.summary())
 }
 
-/// `incise xr` for a Nakao or rheology scene (`exercise_scene`: the scene of a Nakao
-/// exercise), on the simulated headset or the runtime's.
-fn run_method(opts: &XrOptions, exercise_scene: Option<PathBuf>) -> Result<String> {
+/// `incise xr` for a Nakao or rheology `scene` (a Nakao exercise's, with `--exercise`), on
+/// the simulated headset or the runtime's.
+fn run_method(opts: &XrOptions, scene: &Path) -> Result<String> {
     let exercise = opts
         .exercise
         .as_ref()
         .map(|p| method_session::MethodExercise::open(p, &opts.out.join("attempts"), &opts.history))
         .transpose()?;
-    let scene = exercise_scene.unwrap_or_else(|| opts.scene.clone());
-    refuse_xpbd_options(opts, &scene)?;
+    refuse_xpbd_options(opts, scene)?;
     let sim = method_session::MethodSim {
         choice: opts.sim,
         slow: Duration::from_millis(opts.slow_sim_ms),
         frames: opts.frames,
     };
     if let Some(script) = &opts.simulated {
-        return method_session::run_simulated(&scene, script, &opts.out, &sim, exercise);
+        return method_session::run_simulated(scene, script, &opts.out, &sim, exercise);
     }
-    let mut session = open_session(&scene)?;
-    method_session::run_on_runtime(&mut session, &scene, &opts.out, &sim, exercise)
+    let mut session = open_session(scene)?;
+    method_session::run_on_runtime(&mut session, scene, &opts.out, &sim, exercise)
 }
 
 /// The options only an XPBD session uses, refused for a method session's `scene` (naming
@@ -332,12 +326,11 @@ fn run_session(
             &opts.out,
         )),
         // Ctrl-C: the session ended cleanly, but the run was cut short (exit 130).
-        None if outcome.interrupted => Err(crate::interrupt::Interrupted {
-            what: format!("the XR session on {}", report.scene),
-            frames: outcome.frames,
-            out: opts.out.display().to_string(),
-        }
-        .into()),
+        None if outcome.interrupted => Err(xr_report::interrupted(
+            &report.scene,
+            outcome.frames,
+            &opts.out,
+        )),
         None => Ok(report),
     }
 }

@@ -165,6 +165,17 @@ pub fn exit_text(
     }
 }
 
+/// The error of a session Ctrl-C cut short after `frames` display frames (it ended
+/// cleanly, its files in `out` written; exit 130).
+pub fn interrupted(scene: &str, frames: u64, out: &Path) -> anyhow::Error {
+    crate::interrupt::Interrupted {
+        what: format!("the XR session on {scene}"),
+        frames,
+        out: out.display().to_string(),
+    }
+    .into()
+}
+
 /// `e`, the failure that ended a session after `frames` display frames, saying that
 /// `kept` (the files written all the same) in `out` were kept.
 pub fn failed(e: anyhow::Error, frames: u64, kept: &str, out: &Path) -> anyhow::Error {
