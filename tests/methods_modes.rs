@@ -487,3 +487,79 @@ fn a_method_headset_session_refuses_the_xpbd_only_options() {
         );
     }
 }
+
+/// The mean column of the pixels of `img` for which `pred` holds.
+fn mean_column(img: &incise_xr::RgbaImage, pred: impl Fn([u8; 4]) -> bool) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0.0f64);
+    for (i, p) in img.pixels.chunks_exact(4).enumerate() {
+        if pred([p[0], p[1], p[2], p[3]]) {
+            sum += (i as u32 % img.width) as f64;
+            n += 1.0;
+        }
+    }
+    sum / n.max(1.0)
+}
+
+/// A Nakao session in the headset takes the same controls as an XPBD one, through the one
+/// display loop: Menu pauses the body (no body frames, no catching up after), the blade
+/// is drawn where the controller holds it, B turns the heat map off and the left grip's
+/// squeeze moves the tray.
+#[test]
+fn a_nakao_headset_session_pauses_draws_the_blade_and_moves_its_tray() {
+    let dir = temp_dir("mh-nakao-controls");
+    let path = dir.join("headset.ron");
+    // Paused 0.3–1.2 s; the blade (tracked from 0.1 s, trigger held) moves on along its
+    // incision meanwhile; B at 0.7 s; the tray moved 10 cm right at 1.05–1.12 s.
+    let text_ = "(display_hz: 72.0, eye_size: (160, 160), duration: 1.5, render_every: 24,
+          screenshots: [24, 48, 72, 96], pacing: Nominal,
+          head: [(t: 0.0, position: (0.0, 1.25, -0.05),
+                  orientation: (-0.34202, 0.0, 0.0, 0.93969))],
+          right: Some(Tool(start: 0.1, stroke: Incision((start: (-0.05, 0.0, 0.002),
+            end: (0.05, 0.0, 0.002), depth: 0.004, speed: 0.1, approach: 0.005)))),
+          trigger: [(0.0, 1.0)],
+          left: [(t: 0.0, position: (0.1, 0.9, -0.45)), (t: 1.5, position: (0.1, 0.9, -0.45))],
+          squeeze: [(0.0, 0.0), (1.05, 0.0), (1.06, 1.0), (1.12, 1.0), (1.13, 0.0)],
+          buttons: [(0.3, Menu), (0.7, B), (1.2, Menu)])";
+    std::fs::write(&path, text_).unwrap();
+    let out = dir.join("out");
+    if headset("config/plate_cut_nakao.ron", &path, &out).is_none() {
+        return;
+    }
+    let (_, rows) = xr_session(&out, "nakao");
+    let during = |a: f64, b: f64| {
+        rows.iter()
+            .filter(move |f| f["display_time_s"] > a && f["display_time_s"] < b)
+    };
+    let paused: f64 = during(0.32, 1.19).map(|f| f["sim_frames"]).sum();
+    assert_eq!(paused, 0.0, "body frames stepped while paused");
+    let after = during(1.21, 2.0).map(|f| f["sim_frames"]);
+    let (sum, most) = after.fold((0.0, 0.0), |(s, m), n| (s + n, f64::max(m, n)));
+    // 10 ms body frames at 72 Hz: one or two a display frame, none owed for the pause.
+    assert!(
+        sum > 10.0 && most <= 2.0,
+        "after the pause: {sum} frames, {most} at most"
+    );
+    let eye = |frame: u32| {
+        incise_xr::RgbaImage::load_png(&out.join(format!("eye_left_{frame:05}.png"))).unwrap()
+    };
+    let (e24, e48, e72, e96) = (eye(24), eye(48), eye(72), eye(96));
+    // The tissue is still while paused: only the blade moved between 24 and 48.
+    let moved = 1.0 - common::pixels::agreeing_share(&e24, &e48, 8);
+    let moved_px = moved * 160.0 * 160.0;
+    assert!(
+        (20.0..2000.0).contains(&moved_px),
+        "{moved_px:.0} pixels changed with only the blade moving"
+    );
+    // Heat map on (the method's tension: orange, green well above blue) until B, then
+    // the pink skin (green and blue alike).
+    let heat = |img| common::pixels::count(img, |p| p[1] as i32 - p[2] as i32 > 40);
+    assert!(
+        heat(&e48) > 200 && heat(&e72) < 20,
+        "heat-map pixels {} before B, {} after",
+        heat(&e48),
+        heat(&e72)
+    );
+    let shift =
+        mean_column(&e96, common::pixels::is_tissue) - mean_column(&e72, common::pixels::is_tissue);
+    assert!(shift > 5.0, "the organ moved {shift:.1} px with the tray");
+}

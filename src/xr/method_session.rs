@@ -1,35 +1,36 @@
 //! The headset session for a scene of any method: the organ on the tray, its body stepped
-//! on its own thread ([`MethodThread`], the default on a real-time headset: the display
+//! on its own thread ([`super::method_thread`], the default on a real-time headset: the display
 //! draws the newest completed frame and never waits) or inside each display frame up to
 //! the frame's display time (a simulated headset's virtual clock, or `--sim in-frame`),
 //! with the scene's own script (the Nakao blade's stroke, the rheology indenter) until the
 //! right controller's trigger takes the tool: then the scalpel cuts (Nakao) or presses
 //! (rheology) where the controller holds it, vibrating with the method's tool force where
-//! it has one. Both eyes show the heat map of the method's own quantity. Writes the body's
+//! it has one. Both eyes show the heat map of the method's own quantity. The display loop
+//! is XPBD's ([`super::frame_loop`]): the same controls (Menu pauses, B toggles the heat
+//! map, the left grip moves the tray), the blade drawn where the controller holds it, the
+//! same frame log and endings. Writes the body's
 //! `report.json` (the run's schema) into the output folder, and the session's frame log
 //! (`frames.csv`) and `xr_report.json` as an XPBD session does (also when it fails).
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 use glam::{Quat, Vec3};
 use incise_scalpel::HapticCurve;
 use incise_sim::contact::ToolPose;
-use incise_xr::openxr::controls::{ControllerState, commands};
-use incise_xr::openxr::haptics::{HapticCall, HapticGate, haptic_pulse};
-use incise_xr::openxr::lifecycle::ExitReason;
-use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
+use incise_xr::openxr::scalpel_pose::BladeOffset;
 use incise_xr::openxr::tray::Tray;
-use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, eye::eye_view};
-use incise_xr::{Overlays, RenderDevice, RenderSettings, Renderer};
+use incise_xr::openxr::{Headset, HeadsetFrame};
+use incise_xr::{RenderDevice, Renderer};
 
 use super::exercise::XrExercise;
-use super::frame_log::{FrameLog, FrameRow};
-use super::frame_loop::MAX_IDLE;
+use super::frame_loop::{DisplayOptions, DisplayOutcome, drive};
+use super::headset_sim::{HeadsetSim, Picture};
 use super::method_stepper::Stepper;
 use super::script::{HeadsetScript, RightTrack};
 use super::sim_mode::{self, SimChoice, SimMode};
+use super::sim_state::{Advanced, CommandStamp, ToolCommand};
 use super::simulated::SimulatedHeadset;
 use super::xr_report::{self, XrReport};
 use crate::bench::soak::percentile;
@@ -49,42 +50,33 @@ pub struct MethodSim {
     pub frames: Option<u64>,
 }
 
-/// What a method session did.
+/// A method session's body as the display loop drives it.
 struct Session {
     stepper: Stepper,
     drawing: TetDrawing,
     renderer: Renderer,
-    tray: Tray,
+    /// The headset's device and colour format (a changed topology needs a new renderer).
+    dev: (RenderDevice, wgpu::TextureFormat),
     /// Whether the controller has taken the tool from the scene's script.
     hand: bool,
+    /// The blade drawn: the controller's, while it holds the tool and is tracked.
+    drawn_tool: Option<ToolPose>,
     /// The display time of the first frame, s (simulated time 0).
     start: Option<f64>,
-    /// Vibration pulses sent.
-    pulses: u64,
-    /// Vibration stops sent (once each time the blade stopped vibrating).
-    stops: u64,
-    haptic: HapticCurve,
-    /// Whether the controller is vibrating (a stop is sent once when it should stop).
-    gate: HapticGate,
-    /// One row per display frame.
-    log: FrameLog,
-    /// Simulated time given up by an in-frame body slower than real time, s.
+    /// The display time of the previous frame, s.
+    previous: Option<f64>,
+    /// Simulated time held back: given up by an in-frame body slower than real time, and
+    /// the time spent paused, s.
     given_up: f64,
-    /// Why the runtime ended the session, once it has.
-    exit: Option<ExitReason>,
-    /// Whether Ctrl-C asked the session to end.
-    interrupted: bool,
     /// A Nakao exercise: its plan drawn, attempts recorded from the controller and
     /// scored on the body's cut surface (the body stepped in the frame).
-    exercise: Option<MethodExercise>,
+    exercise: Option<HeadsetExercise>,
 }
 
 /// A method session's exercise, with what it needs to reload the scene for a new attempt.
-pub struct MethodExercise {
+pub struct HeadsetExercise {
     /// The exercise and its attempts.
     pub live: XrExercise<RecordedBody>,
-    /// The controllers as of the last display frame (A is acted on when pressed).
-    previous: ControllerState,
     /// The blade's last tracked pose (held, lifted, while the controller is untracked).
     pose: ToolPose,
     /// Where the session writes and how its body frames are slowed: what a new attempt's
@@ -92,13 +84,12 @@ pub struct MethodExercise {
     reload: (PathBuf, Duration),
 }
 
-impl MethodExercise {
+impl HeadsetExercise {
     /// Open the exercise at `path`, attempts saved under `out_root` and appended to
     /// `history`.
-    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<MethodExercise> {
-        Ok(MethodExercise {
+    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<HeadsetExercise> {
+        Ok(HeadsetExercise {
             live: XrExercise::open(path, out_root, history)?,
-            previous: ControllerState::default(),
             // Out of reach until the controller is tracked.
             pose: ToolPose {
                 position: Vec3::new(0.0, 0.0, 1.0),
@@ -117,7 +108,7 @@ pub fn run_simulated(
     script_path: &Path,
     out: &Path,
     sim: &MethodSim,
-    exercise: Option<MethodExercise>,
+    exercise: Option<HeadsetExercise>,
 ) -> Result<String> {
     let script = HeadsetScript::load(script_path)?;
     let (mode, why) = sim_mode::resolve(sim.choice, exercise.is_some(), !script.realtime)?;
@@ -147,7 +138,7 @@ pub fn run_on_runtime(
     scene: &Path,
     out: &Path,
     sim: &MethodSim,
-    exercise: Option<MethodExercise>,
+    exercise: Option<HeadsetExercise>,
 ) -> Result<String> {
     let (mode, why) = sim_mode::resolve(sim.choice, exercise.is_some(), false)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -171,7 +162,7 @@ fn tray_for(drawing: &TetDrawing) -> Tray {
 fn run_on(
     headset: &mut dyn Headset,
     scene: &Path,
-    (stepper, drawing, exercise): (Stepper, TetDrawing, Option<MethodExercise>),
+    (stepper, drawing, exercise): (Stepper, TetDrawing, Option<HeadsetExercise>),
     tray: Tray,
     out: &Path,
     (mode, why): (SimMode, String),
@@ -183,33 +174,29 @@ fn run_on(
         stepper,
         drawing,
         renderer,
-        tray,
+        dev: (dev, headset.format()),
         hand: false,
+        drawn_tool: None,
         start: None,
-        pulses: 0,
-        stops: 0,
-        haptic: HapticCurve::default(),
-        gate: HapticGate::default(),
-        log: FrameLog::default(),
+        previous: None,
         given_up: 0.0,
-        exit: None,
-        interrupted: false,
         exercise,
     };
     if let Some(ex) = &mut s.exercise {
         ex.reload = (out.to_path_buf(), sim.slow);
     }
-    s.start_attempt()?;
-    let started = Instant::now();
-    let ended = s.run(headset, &dev, sim.frames);
-    // The controller may be gone with the session: stopping its vibration can fail.
-    if s.gate.vibrating() && headset.vibrate(None).is_ok() {
-        s.stops += 1;
-    }
-    let wall_s = started.elapsed().as_secs_f64();
-    let report = s.report(headset, scene, (mode, why.clone()), sim.slow)?;
-    let (p50, p95) = s.work_p50_p95();
-    let (report, summary) = s.close(ended, report, wall_s, out)?;
+    let curve = HapticCurve::default();
+    let display = DisplayOptions {
+        max_frames: sim.frames,
+        blade: BladeOffset::default(),
+        haptic: &|f| curve.amplitude(f),
+        tray,
+        played: false,
+    };
+    let shown = drive(headset, &mut s, &display);
+    let report = s.report(headset, scene, &shown, (mode, why.clone()), sim.slow)?;
+    let (p50, p95) = work_p50_p95(&shown);
+    let (report, summary) = s.close(shown, report, out)?;
     Ok(format!(
         "{} on {}: {} display frames ({} rendered), {} vibration pulses, \
          body stepped {} ({why}), display frame work p50 {p50:.2} ms, p95 {p95:.2} ms; {summary}",
@@ -220,6 +207,14 @@ fn run_on(
         report.haptic_pulses,
         mode.name(),
     ))
+}
+
+/// Median and 95th percentile of the display frames' own work (stepping, vibration,
+/// drawing), ms.
+fn work_p50_p95(shown: &DisplayOutcome) -> (f64, f64) {
+    let mut ms: Vec<f64> = shown.log.rows.iter().map(|r| r.frame_ms).collect();
+    ms.sort_by(f64::total_cmp);
+    (percentile(&ms, 0.5), percentile(&ms, 0.95))
 }
 
 /// The scripted right-hand stroke, drawn with the built-in scalpel.
@@ -249,29 +244,10 @@ impl Session {
         ex.live.start(body)
     }
 
-    /// A pressed in an exercise: an attempt the blade touched is finished (its card
-    /// shown); otherwise the scene is loaded afresh and a new attempt starts.
-    fn on_a(&mut self, headset: &dyn Headset, dev: &RenderDevice) -> Result<()> {
-        let (Some(ex), Stepper::InFrame { body, .. }) = (&mut self.exercise, &self.stepper) else {
-            return Ok(());
-        };
-        if !ex.live.on_a(body)? {
-            return Ok(());
-        }
-        let scene = ex.live.exercise().scene_path.clone();
-        let (out, slow) = ex.reload.clone();
-        (self.stepper, self.drawing) = Stepper::open(&scene, &out, SimMode::InFrame, slow)?;
-        self.renderer = renderer_for(dev, headset.format(), &self.drawing);
-        ex.live.renderer_replaced();
-        // The fresh body's time 0 is the next display frame's.
-        (self.start, self.given_up) = (None, 0.0);
-        self.start_attempt()
-    }
-
     /// Keep body frame `b` for the attempt under way, stepped with `tool` (its pose
     /// recorded when the controller tracked it: `tracked`).
     fn keep(
-        ex: &mut MethodExercise,
+        ex: &mut HeadsetExercise,
         b: &RecordedBody,
         tool: &ToolInput,
         tracked: bool,
@@ -284,89 +260,32 @@ impl Session {
             .after_step(ToolFrame::of(frame), pose, b.body.frame_dt())
     }
 
-    /// Display frames until the session ends, asking the runtime to end it after
-    /// `max_frames` or on Ctrl-C (as the XPBD loop does, so the files are saved as after
-    /// any other end).
-    fn run(
-        &mut self,
-        headset: &mut dyn Headset,
-        dev: &RenderDevice,
-        max_frames: Option<u64>,
-    ) -> Result<()> {
-        let mut exit_asked = false;
-        while let Some(frame) = self.next(headset, &mut exit_asked)? {
-            self.frame(headset, dev, &frame)?;
-            let limit = max_frames.is_some_and(|m| self.log.rows.len() as u64 >= m);
-            self.maybe_exit(headset, &mut exit_asked, limit)?;
-        }
-        Ok(())
-    }
-
-    /// Ask the runtime to end the session once: on Ctrl-C, or when `limit` is reached.
-    fn maybe_exit(
-        &mut self,
-        headset: &mut dyn Headset,
-        asked: &mut bool,
-        limit: bool,
-    ) -> Result<()> {
-        let interrupted = crate::interrupt::requested();
-        if !*asked && (interrupted || limit) {
-            *asked = true;
-            self.interrupted = interrupted;
-            headset.request_exit()?;
-        }
-        Ok(())
-    }
-
-    /// The next begun frame, `None` when the session has ended (the runtime's reason kept)
-    /// or the runtime answered Idle [`MAX_IDLE`] times in a row.
-    fn next(
-        &mut self,
-        headset: &mut dyn Headset,
-        asked: &mut bool,
-    ) -> Result<Option<HeadsetFrame>> {
-        for _ in 0..=MAX_IDLE {
-            match headset.next_frame()? {
-                FrameEvent::Frame(f) => return Ok(Some(*f)),
-                // Ctrl-C before the runtime runs the session ends it at once.
-                FrameEvent::Idle => self.maybe_exit(headset, asked, false)?,
-                FrameEvent::Ended(why) => {
-                    self.exit = Some(why);
-                    return Ok(None);
-                }
-            }
-        }
-        Ok(None)
-    }
-
-    /// Close the body after the session `ended` (its `report.json` written unless the
+    /// Close the body after the display loop (its `report.json` written unless the
     /// session failed), then write `frames.csv` and `report` (completed with the body
-    /// frames stepped, their rate over `wall_s` and how the session ended) into `out`,
-    /// also on a failure; the report and the body's summary line.
+    /// frames stepped, their rate over the loop's wall time and how the session ended)
+    /// into `out`, also on a failure; the report and the body's summary line.
     fn close(
-        mut self,
-        ended: Result<()>,
+        self,
+        shown: DisplayOutcome,
         mut report: XrReport,
-        wall_s: f64,
         out: &Path,
     ) -> Result<(XrReport, String)> {
-        let saved = match (&mut self.exercise, &self.stepper) {
-            (Some(ex), Stepper::InFrame { body, .. }) => ex.live.end_session(body),
-            _ => Ok(()),
+        let closed = match shown.error {
+            Some(e) => Err(e),
+            None => self.stepper.close(out),
         };
-        let closed = ended.and(saved).and_then(|()| self.stepper.close(out));
         if let Ok((_, frames)) = &closed {
             report.sim_frames = *frames as u64;
         }
-        if wall_s > 0.0 {
-            report.sim_steps_per_s = report.sim_frames as f64 / wall_s;
+        if shown.wall_s > 0.0 {
+            report.sim_steps_per_s = report.sim_frames as f64 / shown.wall_s;
         }
-        report.exit = xr_report::exit_text(closed.as_ref().err(), self.interrupted, self.exit);
-        report.save(&self.log, out)?;
+        report.exit = xr_report::exit_text(closed.as_ref().err(), shown.interrupted, shown.exit);
+        report.save(&shown.log, out)?;
         let kept = "the frame log and xr_report.json";
         match closed {
             // Ctrl-C: the session ended cleanly, but the run was cut short (exit 130).
-            Ok(_) if self.interrupted => {
+            Ok(_) if shown.interrupted => {
                 Err(xr_report::interrupted(&report.scene, report.frames, out))
             }
             Ok((summary, _)) => Ok((report, summary)),
@@ -374,25 +293,19 @@ impl Session {
         }
     }
 
-    /// Median and 95th percentile of the display frames' own work (stepping, vibration,
-    /// drawing), ms.
-    fn work_p50_p95(&self) -> (f64, f64) {
-        let mut ms: Vec<f64> = self.log.rows.iter().map(|r| r.frame_ms).collect();
-        ms.sort_by(f64::total_cmp);
-        (percentile(&ms, 0.5), percentile(&ms, 0.95))
-    }
-
-    /// The session's `xr_report.json` so far: `scene` on `headset`, stepped `mode` (why),
-    /// each body frame slowed by `slow`, the frames stepped as many as published.
+    /// The session's `xr_report.json` so far: `scene` on `headset` as the display loop
+    /// `shown` it, stepped `mode` (why), each body frame slowed by `slow`, the frames
+    /// stepped as many as published.
     fn report(
         &self,
         headset: &dyn Headset,
         scene: &Path,
+        shown: &DisplayOutcome,
         (mode, why): (SimMode, String),
         slow: Duration,
     ) -> Result<XrReport> {
         let (method, solver_device) = self.stepper.body()?;
-        let rows = &self.log.rows;
+        let rows = &shown.log.rows;
         Ok(XrReport {
             scene: scene.display().to_string(),
             solver_device,
@@ -400,8 +313,8 @@ impl Session {
             sim_mode_why: why,
             sim_frames: self.stepper.frames() as u64,
             max_tool_force: rows.iter().map(|r| r.tool_force).fold(0.0, f32::max),
-            haptic_pulses: self.pulses,
-            haptic_stops: self.stops,
+            haptic_pulses: shown.haptic_pulses,
+            haptic_stops: shown.haptic_stops,
             dropped_time_s: self.given_up,
             slow_sim_ms: slow.as_millis() as u64,
             exercise: (self.exercise.as_ref())
@@ -410,31 +323,100 @@ impl Session {
                 .exercise
                 .as_ref()
                 .map_or(Vec::new(), |e| e.live.attempts.clone()),
-            ..XrReport::new(method, &self.log, headset)
+            ..XrReport::new(method, &shown.log, headset)
         })
     }
 
-    /// One display frame: step the body up to the frame's display time with the tool,
-    /// vibrate, draw both eyes, log the frame's row (also when ending the frame failed).
-    fn frame(
-        &mut self,
-        headset: &mut dyn Headset,
-        dev: &RenderDevice,
-        f: &HeadsetFrame,
-    ) -> Result<()> {
-        let started = Instant::now();
+    /// The frame's tool from its command: the scene's script until the trigger engages
+    /// the controller's.
+    fn tool(&mut self, cmd: &ToolCommand) -> ToolInput {
+        self.hand |= cmd.engaged && cmd.pose.is_some();
         if let Some(ex) = &mut self.exercise {
-            let pressed = commands(&ex.previous, &f.controllers);
-            ex.previous = f.controllers;
-            if pressed.reset {
-                self.on_a(headset, dev)?;
+            // An exercise's blade is the controller's from the start (the scene's scripted
+            // cut must not open the tissue), held where it was while untracked.
+            self.hand = true;
+            if let Some(pose) = cmd.pose {
+                ex.pose = pose;
+            }
+            return ToolInput::Hand {
+                pose: ex.pose,
+                engaged: cmd.engaged && cmd.pose.is_some(),
+            };
+        }
+        match (self.hand, cmd.pose) {
+            (true, Some(pose)) => ToolInput::Hand {
+                pose,
+                engaged: cmd.engaged,
+            },
+            _ => ToolInput::Script,
+        }
+    }
+
+    /// Simulated time the body is stepped to at `frame`: the display time since the
+    /// first frame, less the time given up and the time paused (`paused`).
+    fn until(&mut self, frame: &HeadsetFrame, paused: bool) -> f64 {
+        let start = *self.start.get_or_insert(frame.display_time);
+        let previous = self.previous.replace(frame.display_time);
+        if paused {
+            self.given_up += previous.map_or(0.0, |p| frame.display_time - p);
+        }
+        frame.display_time - start - self.given_up
+    }
+
+    /// A new drawing `view` of the body: a changed topology needs a new renderer (and the
+    /// card uploaded to it again).
+    fn redraw(&mut self, view: crate::sim_body::TetView) -> Result<()> {
+        if self.drawing.update(view)? {
+            self.renderer = renderer_for(&self.dev.0, self.dev.1, &self.drawing);
+            if let Some(ex) = &mut self.exercise {
+                ex.live.renderer_replaced();
             }
         }
-        let start = *self.start.get_or_insert(f.display_time);
-        let tool = self.tool(f);
-        let stamp = (self.log.rows.len() as u64, f.display_time);
-        let until = f.display_time - start - self.given_up;
-        let tracked = f.controllers.right_grip.is_some();
+        Ok(())
+    }
+}
+
+impl HeadsetSim for Session {
+    fn heat_map_at_start(&self) -> bool {
+        // The method's own quantity (tension, strain) is what the session is for.
+        true
+    }
+
+    fn start(&mut self) -> Result<()> {
+        self.start_attempt()
+    }
+
+    /// A pressed in an exercise: an attempt the blade touched is finished (its card
+    /// shown); otherwise the scene is loaded afresh and a new attempt starts. Outside an
+    /// exercise A does nothing (the body's report covers one body).
+    fn on_a(&mut self) -> Result<()> {
+        let (Some(ex), Stepper::InFrame { body, .. }) = (&mut self.exercise, &self.stepper) else {
+            return Ok(());
+        };
+        if !ex.live.on_a(body)? {
+            return Ok(());
+        }
+        let scene = ex.live.exercise().scene_path.clone();
+        let (out, slow) = ex.reload.clone();
+        (self.stepper, self.drawing) = Stepper::open(&scene, &out, SimMode::InFrame, slow)?;
+        self.renderer = renderer_for(&self.dev.0, self.dev.1, &self.drawing);
+        ex.live.renderer_replaced();
+        // The fresh body's time 0 is the next display frame's.
+        (self.start, self.previous, self.given_up) = (None, None, 0.0);
+        self.start_attempt()
+    }
+
+    /// Step the body up to the frame's display time with the frame's tool (held while
+    /// paused).
+    fn advance(&mut self, frame: &HeadsetFrame, cmd: &ToolCommand) -> Result<Advanced> {
+        let tool = self.tool(cmd);
+        self.drawn_tool = match tool {
+            ToolInput::Hand { pose, .. } if cmd.pose.is_some() => Some(pose),
+            _ => None,
+        };
+        let until = self.until(frame, cmd.paused);
+        let stamp = (cmd.frame, frame.display_time);
+        let tracked = cmd.pose.is_some();
         let ex = &mut self.exercise;
         let step = self
             .stepper
@@ -443,130 +425,44 @@ impl Session {
                 None => Ok(()),
             })?;
         self.given_up += step.given_up;
-        if let Some(view) = step.view
-            && self.drawing.update(view)?
-        {
-            // The topology changed (the new renderer needs the card again).
-            self.renderer = renderer_for(dev, headset.format(), &self.drawing);
-            if let Some(ex) = &mut self.exercise {
-                ex.live.renderer_replaced();
-            }
+        if let Some(view) = step.view {
+            self.redraw(view)?;
         }
-        let adv = step.done;
-        let haptic = self.vibrate(headset, adv.tool_force, f.display_period)?;
-        let render_start = Instant::now();
-        // A frame the runtime fails to end is still logged: its body frames were stepped.
-        let ended = if f.should_render {
-            self.render(headset, dev, f)
-        } else {
-            headset.end_frame(false).map_err(anyhow::Error::from)
-        };
-        let rendered = f.should_render && ended.is_ok();
-        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
-        self.log.rows.push(FrameRow {
-            frame: stamp.0,
-            display_time: f.display_time,
-            sim_frames: adv.sim_frames,
-            substeps: adv.substeps,
-            sim_ms: adv.sim_ms,
-            render_ms: ms(render_start),
-            frame_ms: ms(started),
-            rendered,
-            engaged: f.controllers.blade_engaged(),
-            tool_force: adv.tool_force,
-            haptic,
-            display_period: f.display_period,
-            tool_latency_ms: (self.stepper.last_command())
-                .filter(|_| rendered)
-                .map(|(_, t)| (f.display_time - t) * 1e3),
-        });
-        ended
+        Ok(step.done)
     }
 
-    /// Vibrate with the tool force `force`, N, while the controller holds the tool; the
-    /// amplitude sent.
-    fn vibrate(&mut self, headset: &mut dyn Headset, force: f32, period: f64) -> Result<f32> {
-        let pulse = haptic_pulse(self.haptic.amplitude(force), self.hand, period);
-        match self.gate.send(pulse, |p| headset.vibrate(p))? {
-            HapticCall::Apply(_) => self.pulses += 1,
-            HapticCall::Stop => self.stops += 1,
-            HapticCall::Nothing => {}
-        }
-        Ok(pulse.map_or(0.0, |p| p.amplitude))
+    fn vibrates(&self, _: &ToolCommand) -> bool {
+        // The method's tool force is felt while the controller holds the tool.
+        self.hand
     }
 
-    /// Both eyes, drawn from the body's newest frame.
-    fn render(
-        &mut self,
-        headset: &mut dyn Headset,
-        dev: &RenderDevice,
-        f: &HeadsetFrame,
-    ) -> Result<()> {
-        let targets = headset.acquire()?;
-        let stage_from_sim = self.tray.stage_from_sim();
-        let views = f
-            .eyes
-            .map(|(pose, fov)| eye_view(pose, fov, stage_from_sim));
-        let (background, background_alpha) = headset.backdrop().clear();
+    fn picture(&mut self, tray: &Tray, head: Vec3) -> Result<Option<Picture<'_>>> {
         let (lines, panel) = match &mut self.exercise {
             Some(ex) => {
-                let head = (f.eyes[0].0.position + f.eyes[1].0.position) * 0.5;
-                let panel = ex.live.panel(&mut self.renderer, dev, &self.tray, head)?;
+                let panel = ex.live.panel(&mut self.renderer, &self.dev.0, tray, head)?;
                 let line = ex.live.decal().line(self.drawing.state().positions);
                 (vec![line], panel)
             }
             None => (Vec::new(), None),
         };
-        let settings = RenderSettings {
-            overlays: Overlays {
-                stress: true,
-                ..Overlays::default()
-            },
-            stress_max: self.drawing.scale,
-            background,
-            background_alpha,
+        Ok(Some(Picture {
+            renderer: &mut self.renderer,
+            body: self.drawing.state(),
+            heat_max: self.drawing.scale,
+            tool: self.drawn_tool,
             lines,
             panel,
-            ..RenderSettings::default()
-        };
-        let mut enc = dev
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("xr method frame"),
-            });
-        self.renderer
-            .prepare(&mut enc, &self.drawing.state(), &settings);
-        self.renderer.render(
-            &mut enc,
-            &[(views[0], &targets[0]), (views[1], &targets[1])],
-            headset.eye_size(),
-        );
-        dev.queue.submit([enc.finish()]);
-        Ok(headset.end_frame(true)?)
+        }))
     }
 
-    /// The frame's tool: the scene's script until the trigger engages the controller's.
-    fn tool(&mut self, f: &HeadsetFrame) -> ToolInput {
-        let c = f.controllers;
-        self.hand |= c.blade_engaged() && c.right_grip.is_some();
-        if let Some(ex) = &mut self.exercise {
-            // An exercise's blade is the controller's from the start (the scene's scripted
-            // cut must not open the tissue), held where it was while untracked.
-            self.hand = true;
-            if let Some(grip) = c.right_grip {
-                ex.pose = scalpel_pose(grip, BladeOffset::default(), &self.tray);
-            }
-            return ToolInput::Hand {
-                pose: ex.pose,
-                engaged: c.blade_engaged() && c.right_grip.is_some(),
-            };
-        }
-        match (self.hand, c.right_grip) {
-            (true, Some(grip)) => ToolInput::Hand {
-                pose: scalpel_pose(grip, BladeOffset::default(), &self.tray),
-                engaged: c.blade_engaged(),
-            },
-            _ => ToolInput::Script,
+    fn shown_command(&self) -> Option<CommandStamp> {
+        self.stepper.last_command()
+    }
+
+    fn end(&mut self) -> Result<()> {
+        match (&mut self.exercise, &self.stepper) {
+            (Some(ex), Stepper::InFrame { body, .. }) => ex.live.end_session(body),
+            _ => Ok(()),
         }
     }
 }

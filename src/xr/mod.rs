@@ -1,10 +1,13 @@
 //! `incise xr [SCENE]`: the scene on a tray in the room, cut with the right controller
 //! (issue 7). With `--simulated-headset SCRIPT.ron` the same frame loop runs without a
-//! runtime on a scripted headset, rendering both eyes offscreen.
+//! runtime on a scripted headset, rendering both eyes offscreen. One display loop
+//! ([`frame_loop`]) drives every method's session: XPBD's ([`xpbd_session`]) and the
+//! others' ([`method_session`]), through [`headset_sim::HeadsetSim`].
 
 pub mod exercise;
 pub mod frame_log;
 pub mod frame_loop;
+pub mod headset_sim;
 pub mod in_frame;
 pub mod latest;
 pub mod method_session;
@@ -18,6 +21,7 @@ pub mod sim_step;
 pub mod sim_thread;
 pub mod simulated;
 pub mod unavailable;
+pub mod xpbd_session;
 pub mod xr_body;
 pub mod xr_report;
 
@@ -33,12 +37,12 @@ use incise_xr::openxr::{Headset, XrSession};
 
 use crate::sim_body::{DeviceChoice, Method};
 use exercise::XrExercise;
-use frame_loop::{LoopOptions, LoopOutcome, run_loop};
 use script::{HeadsetScript, Pacing, RightTrack};
 use sim_mode::{SimChoice, SimMode};
 use sim_step::SimFaults;
 use simulated::SimulatedHeadset;
 pub use unavailable::XrUnavailable;
+use xpbd_session::{LoopOptions, LoopOutcome, run_loop};
 use xr_body::XrBody;
 pub use xr_report::XrReport;
 
@@ -97,7 +101,9 @@ fn run_method(opts: &XrOptions, scene: &Path) -> Result<String> {
     let exercise = opts
         .exercise
         .as_ref()
-        .map(|p| method_session::MethodExercise::open(p, &opts.out.join("attempts"), &opts.history))
+        .map(|p| {
+            method_session::HeadsetExercise::open(p, &opts.out.join("attempts"), &opts.history)
+        })
         .transpose()?;
     refuse_xpbd_options(opts, scene)?;
     let sim = method_session::MethodSim {
@@ -299,8 +305,8 @@ fn run_session(
         released_tets: Some(outcome.released_tets),
         cut_box: outcome.cut_box,
         max_tool_force: outcome.max_tool_force,
-        haptic_pulses: outcome.haptic_pulses,
-        haptic_stops: outcome.haptic_stops,
+        haptic_pulses: outcome.display.haptic_pulses,
+        haptic_stops: outcome.display.haptic_stops,
         dropped_time_s: outcome.dropped_time,
         sim_steps_per_s: if outcome.sim_wall_s > 0.0 {
             outcome.sim_frames as f64 / outcome.sim_wall_s
@@ -310,25 +316,29 @@ fn run_session(
         slow_sim_ms: opts.slow_sim_ms,
         substeps: Some((xr.nominal_substeps(), outcome.min_substeps_used)),
         solver_resets: Some(outcome.solver_resets),
-        exit: xr_report::exit_text(outcome.error.as_ref(), outcome.interrupted, outcome.exit),
+        exit: xr_report::exit_text(
+            outcome.display.error.as_ref(),
+            outcome.display.interrupted,
+            outcome.display.exit,
+        ),
         stroke: stroke_path,
         played_stroke: opts.stroke.as_ref().map(|p| p.display().to_string()),
         exercise: opts.exercise.as_ref().map(|p| p.display().to_string()),
         attempts: exercise.map(|e| e.attempts.clone()).unwrap_or_default(),
-        ..XrReport::new(Method::Xpbd, &outcome.log, headset)
+        ..XrReport::new(Method::Xpbd, &outcome.display.log, headset)
     };
-    report.save(&outcome.log, &opts.out)?;
-    match outcome.error.take() {
+    report.save(&outcome.display.log, &opts.out)?;
+    match outcome.display.error.take() {
         Some(e) => Err(xr_report::failed(
             e,
-            outcome.frames,
+            outcome.display.frames,
             "the frame log, the stroke and xr_report.json",
             &opts.out,
         )),
         // Ctrl-C: the session ended cleanly, but the run was cut short (exit 130).
-        None if outcome.interrupted => Err(xr_report::interrupted(
+        None if outcome.display.interrupted => Err(xr_report::interrupted(
             &report.scene,
-            outcome.frames,
+            outcome.display.frames,
             &opts.out,
         )),
         None => Ok(report),

@@ -52,8 +52,8 @@ pub struct XrReport {
     pub max_haptic: f32,
     /// Vibration pulses sent.
     pub haptic_pulses: u64,
-    /// Vibration stops sent (XPBD: once each time the blade left the tissue; another
-    /// method: every display frame without a pulse).
+    /// Vibration stops sent: once each time the vibration ended, and once at the end if
+    /// it was still vibrating.
     pub haptic_stops: u64,
     /// Simulated time given up, s (another method: by its body stepped in the frame and
     /// slower than real time; on its thread it falls behind instead).
@@ -87,7 +87,7 @@ pub struct XrReport {
     pub stroke: Option<String>,
     /// The stroke file that drove the scalpel (`--stroke`), if any (XPBD only).
     pub played_stroke: Option<String>,
-    /// The exercise file, in an exercise session (XPBD only).
+    /// The exercise file, in an exercise session.
     pub exercise: Option<String>,
     /// The exercise attempts finished and saved in the session.
     pub attempts: Vec<AttemptSummary>,
