@@ -232,6 +232,16 @@ fn a_nakao_exercise_draws_its_plan_in_the_method_window() {
         (60..5000).contains(&violet),
         "the plan line should be on the plate: {violet} violet pixels"
     );
+    // The mouse's scalpel, drawn where it waits above the plate: light neutral grey (the
+    // plate's heat map is orange, the background dark).
+    let steel = (0..img.height)
+        .flat_map(|y| (300..img.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.get(x, y).map(i32::from);
+            p[0] > 180 && (p[0] - p[1]).abs() < 15 && (p[1] - p[2]).abs() < 15
+        })
+        .count();
+    assert!(steel > 500, "no scalpel drawn: {steel} steel pixels");
     // The blade is the mouse's from the start: the scene's scripted cut (from 0.2 s) does
     // not open the plate before an attempt.
     let o = Command::new("xvfb-run")
@@ -358,5 +368,116 @@ fn preview_window_shows_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
         "preview 3D view",
         &crop_right(&cpu, panel),
         &crop_right(&gpu, panel),
+    );
+}
+
+/// The files in `dir` whose names start with `stem` and end with `ext`.
+fn saved(dir: &std::path::Path, stem: &str, ext: &str) -> Vec<std::path::PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    entries
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_string_lossy();
+            name.starts_with(stem) && name.ends_with(ext)
+        })
+        .collect()
+}
+
+/// The method window's panel (clicked with xdotool at its buttons' places in the 900 ×
+/// 600 window) saves a `.vtu` and a screenshot, turns the heat map off and resets the
+/// Nakao plate to the scene as loaded.
+#[test]
+fn the_method_window_panel_saves_toggles_the_heat_map_and_resets() {
+    let have = |tool: &str| {
+        Command::new("which")
+            .arg(tool)
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !have("xvfb-run") || !have("xdotool") {
+        assert!(
+            !required(),
+            "INCISE_REQUIRE_GPU=1 but xvfb-run or xdotool is missing"
+        );
+        eprintln!("skipping: xvfb-run or xdotool is not installed");
+        return;
+    }
+    let dir = temp_dir("xvfb-method-panel");
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut_nakao.ron");
+    let last = dir.join("last.png");
+    // Save .vtu (188, 184), Screenshot (105, 184), the heat map box (15, 161), Reset
+    // (32, 184), then Escape at once (the fresh body a few frames old).
+    let script = format!(
+        r#"timeout 120 {bin} preview {scene} --frames 100000 --size 900x600 --screenshot {last} &
+P=$!
+W=$(xdotool search --sync --name "incise preview")
+sleep 3
+click() {{ xdotool mousemove --window $W $1 $2; sleep 0.3; xdotool click 1; sleep 1; }}
+click 188 184
+click 105 184
+click 15 161
+click 32 184
+xdotool windowfocus $W
+xdotool key Escape
+wait $P"#,
+        bin = env!("CARGO_BIN_EXE_incise"),
+        scene = scene.display(),
+        last = last.display(),
+    );
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", "bash", "-c", &script])
+        .current_dir(&dir)
+        .env("XDG_RUNTIME_DIR", &dir)
+        .output()
+        .expect("xvfb-run runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    if !o.status.success() && err.contains("no GPU adapter") && !required() {
+        eprintln!("skipping: {err}");
+        return;
+    }
+    assert!(o.status.success(), "preview failed: {err}");
+    let vtu = saved(&dir.join("out/preview"), "plate_cut_nakao_f", ".vtu");
+    assert_eq!(vtu.len(), 1, "no .vtu saved: {vtu:?}");
+    assert!(
+        std::fs::read_to_string(&vtu[0])
+            .unwrap()
+            .contains("<VTKFile")
+    );
+    let shots = saved(&dir.join("screenshots"), "plate_cut_nakao_f", ".png");
+    assert_eq!(shots.len(), 1, "no screenshot saved: {shots:?}");
+    // Orange heat map (green well above blue) in the screenshot, the pink skin after the
+    // box was cleared.
+    let heat = |img: &RgbaImage| {
+        (0..img.height)
+            .flat_map(|y| (300..img.width).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                let p = img.get(x, y);
+                p[1] as i32 - p[2] as i32 > 40
+            })
+            .count()
+    };
+    let shot = RgbaImage::load_png(&shots[0]).unwrap();
+    let end = RgbaImage::load_png(&last).unwrap();
+    assert!(
+        heat(&shot) > 5000 && heat(&end) < 100,
+        "heat-map pixels {} with the box, {} without",
+        heat(&shot),
+        heat(&end)
+    );
+    // Reset: the body at the end is a fresh one, younger than the screenshot's.
+    let name = shots[0].file_stem().unwrap().to_string_lossy().into_owned();
+    let shot_frame: u64 = name.rsplit('f').next().unwrap().parse().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    let completed: u64 = out
+        .split("completed ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no summary: {out}"));
+    assert!(
+        completed < shot_frame,
+        "{completed} frames at the end against {shot_frame} at the screenshot: no reset"
     );
 }

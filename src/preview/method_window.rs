@@ -3,7 +3,9 @@
 //! the scene's own script (the Nakao blade's stroke, the rheology indenter) until the
 //! left button takes the tool: then the mouse scalpel cuts (Nakao) or presses (rheology)
 //! where it is. Right-drag orbits, middle- or shift+right-drag pans, the wheel zooms,
-//! Space plays/pauses, Escape quits. The panel shows a Nakao body's localisation each
+//! Space plays/pauses, Escape quits. The mouse's scalpel is drawn once it holds the tool;
+//! the panel toggles the heat map, resets the scene, saves a screenshot or a `.vtu`. The
+//! panel shows a Nakao body's localisation each
 //! frame: the level chosen (by the refresh-rate manager under a budget), the free nodes
 //! and the loop's time split. `--frames N` steps and draws N frames and closes, printing
 //! the body's report summary (what it cut, how deep it was pressed) and the last frame's
@@ -12,8 +14,9 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
-use incise_xr::{Overlays, RenderSettings, Renderer};
+use anyhow::{Context, Result};
+use glam::Mat4;
+use incise_xr::{Overlays, RenderSettings, Renderer, ToolState};
 use winit::event::ElementState;
 
 use super::camera_input::preview_camera;
@@ -64,6 +67,10 @@ struct Live {
     /// Whether the mouse has taken the tool from the scene's script.
     hand: bool,
     playing: bool,
+    /// Whether the heat map is drawn (else the skin).
+    heat_map: bool,
+    /// Save the next frame drawn as a screenshot (the panel's button).
+    capture_next: bool,
     frames: u64,
     message: String,
     /// The open exercise.
@@ -94,13 +101,21 @@ impl WindowContent for Live {
         }
         let (panel, panel_points) = self.panel();
         let last = self.shell.quitting || self.w.frames.is_some_and(|n| self.frames + 1 >= n);
-        let capture = last && self.w.screenshot.is_some();
+        let capture = self.capture_next || (last && self.w.screenshot.is_some());
         let settings = RenderSettings {
             overlays: Overlays {
-                stress: true,
+                stress: self.heat_map,
                 ..Overlays::default()
             },
             stress_max: self.body.drawing.scale,
+            // The mouse's scalpel, once it holds the tool.
+            tool: ToolState {
+                transform: self.hand.then(|| {
+                    let p = self.scalpel.pose();
+                    Mat4::from_rotation_translation(p.rotation, p.position)
+                }),
+                spheres: vec![],
+            },
             lines: self
                 .exercise
                 .iter()
@@ -116,8 +131,17 @@ impl WindowContent for Live {
             return Ok(true);
         };
         self.frames += 1;
-        if let (true, Some(path)) = (capture, &self.w.screenshot) {
-            save_frame(image, path)?;
+        if capture {
+            self.capture_next = false;
+            let path = match (&self.w.screenshot, last) {
+                (Some(p), true) => p.clone(),
+                _ => self.snapshot_path("screenshots", "png"),
+            };
+            match save_frame(image, &path) {
+                Ok(()) => self.message = format!("saved {}", path.display()),
+                Err(e) if !last => self.message = format!("{e:#}"),
+                Err(e) => return Err(e),
+            }
         }
         Ok(!last)
     }
@@ -194,6 +218,8 @@ impl Live {
             // cut must not open the tissue before the attempt.
             hand: exercise.is_some(),
             playing: true,
+            heat_map: true,
+            capture_next: false,
             frames: 0,
             message: exercise.as_ref().map_or(String::new(), |e| {
                 format!(
@@ -254,6 +280,42 @@ impl Live {
         };
     }
 
+    /// The scene afresh, its script holding the tool again.
+    fn reset(&mut self) {
+        match DrawnBody::open(&self.w.scene) {
+            Ok(body) => {
+                self.body = body;
+                self.renderer = renderer_for(&self.shell.gpu, &self.body);
+                self.hand = false;
+                self.scalpel.release();
+                self.message = "reset: the scene as loaded".into();
+            }
+            Err(e) => self.message = format!("{e:#}"),
+        }
+    }
+
+    /// `dir/<scene>_f<frame>.<ext>`: where the panel's buttons save.
+    fn snapshot_path(&self, dir: &str, ext: &str) -> PathBuf {
+        let name = self
+            .w
+            .scene
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy();
+        let frame = self.body.sim.frames();
+        Path::new(dir).join(format!("{name}_f{frame:05}.{ext}"))
+    }
+
+    /// The body as a `.vtu` in `out/preview/` (for ParaView); its path.
+    fn save_vtu(&self) -> Result<PathBuf> {
+        let path = self.snapshot_path("out/preview", "vtu");
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        }
+        self.body.sim.body.write_vtu(&path)?;
+        Ok(path)
+    }
+
     /// What moves the tool this frame: the scene's script until the mouse took it.
     fn tool_input(&mut self) -> ToolInput {
         if !self.hand {
@@ -271,8 +333,9 @@ impl Live {
         let body = &self.body;
         let (method, quantity) = (body.sim.body.method().name(), body.quantity());
         let live_lines = body.sim.live_lines();
-        let (mut width, mut playing) = (0.0, self.playing);
+        let (mut width, mut playing, mut heat_map) = (0.0, self.playing, self.heat_map);
         let (mut start, mut finish) = (false, false);
+        let [mut reset, mut shot, mut vtu] = [false; 3];
         let attempt = self.exercise.as_ref().map(|e| e.live.running());
         let message = &self.message;
         let frame = self.shell.panel(|ui| {
@@ -295,6 +358,13 @@ impl Live {
                         ui.label(line.as_str());
                     }
                     ui.checkbox(&mut playing, "play (Space)");
+                    ui.checkbox(&mut heat_map, "heat map");
+                    ui.horizontal(|ui| {
+                        // An exercise starts over with its Start attempt button.
+                        reset = attempt.is_none() && ui.button("Reset").clicked();
+                        shot = ui.button("Screenshot").clicked();
+                        vtu = ui.button("Save .vtu").clicked();
+                    });
                     if let Some(running) = attempt {
                         ui.separator();
                         start = ui.button("Start attempt").clicked();
@@ -311,6 +381,17 @@ impl Live {
             width = shown.response.rect.width();
         });
         self.playing = playing;
+        self.heat_map = heat_map;
+        self.capture_next |= shot;
+        if reset {
+            self.reset();
+        }
+        if vtu {
+            self.message = match self.save_vtu() {
+                Ok(path) => format!("saved {}", path.display()),
+                Err(e) => format!("{e:#}"),
+            };
+        }
         if start {
             self.start_attempt();
         }
