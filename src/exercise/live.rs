@@ -16,10 +16,23 @@ use super::{
     Attempt, CutImages, LoadedExercise, PlanDecal, ReferenceStyle, Standing, ToolFrame,
     load_exercise, read_history, reference_stroke, render_card, save_attempt, score_attempt,
 };
-use crate::pictures::screenshots::Screenshots;
+use crate::pictures::screenshots::{ImageSize, Screenshots};
 use crate::pictures::view_pictures::ViewPictures;
 use crate::sim_body::recorded::RecordedBody;
 use crate::sim_body::{Body, RestCut};
+
+/// Size of the before/after pictures in a live attempt's report, pixels.
+pub const ATTEMPT_PICTURE: ImageSize = ImageSize(960, 540);
+
+/// The offscreen pictures of a method body's live attempt: its tet view with the heat map
+/// of the method's quantity (an error kept as text: the attempt is then saved without).
+pub fn attempt_view_pictures() -> Result<ViewPictures, String> {
+    let heat_map = incise_xr::Overlays {
+        stress: true,
+        ..Default::default()
+    };
+    ViewPictures::new(ATTEMPT_PICTURE, heat_map).map_err(|e| format!("{e:#}"))
+}
 
 /// Where a live attempt's scalpel path is recorded on a body `B`: the preview's hand
 /// tool, the XR mode's controller, the method window's mouse blade.
@@ -57,8 +70,7 @@ impl AttemptBody for Body {
         Some(self.solver().mesh().tet_count())
     }
     fn rest_cut(&self) -> Result<RestCut> {
-        let live = self.solver().cut().live();
-        Ok(RestCut::Released(live.iter().map(|l| !l).collect()))
+        Ok(RestCut::released_of(self.solver()))
     }
     fn device(&self) -> String {
         Body::device(self)

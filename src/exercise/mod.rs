@@ -7,7 +7,7 @@ mod attempt;
 mod cut_reading;
 mod decal;
 mod history;
-mod live;
+pub mod live;
 mod load;
 mod metrics;
 mod model;

@@ -9,15 +9,12 @@ use std::path::Path;
 use anyhow::Result;
 use glam::Vec3;
 use incise_sim::contact::ToolPose;
-use incise_xr::{Overlays, SurfaceLine};
+use incise_xr::SurfaceLine;
 
+use crate::exercise::live::attempt_view_pictures;
 use crate::exercise::{Finished, LiveExercise, PoseRecording, ToolFrame};
-use crate::pictures::screenshots::ImageSize;
 use crate::pictures::view_pictures::ViewPictures;
 use crate::sim_body::recorded::RecordedBody;
-
-/// Size of the report's before/after pictures, pixels.
-const PICTURE: ImageSize = ImageSize(960, 540);
 
 /// An exercise open in the method window.
 pub struct MethodExercise {
@@ -38,11 +35,7 @@ impl MethodExercise {
 
     /// Start an attempt on `body`, the exercise's scene as loaded.
     pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
-        let heat_map = Overlays {
-            stress: true,
-            ..Overlays::default()
-        };
-        let pictures = ViewPictures::new(PICTURE, heat_map).map_err(|e| format!("{e:#}"));
+        let pictures = attempt_view_pictures();
         self.live.start(&mut self.stroke, body, pictures)
     }
 

@@ -29,6 +29,7 @@ use winit::keyboard::ModifiersState;
 use crate::pictures::screenshots::{ImageSize, Screenshots, stress_scale};
 use crate::sim_body::{Body, DeviceChoice};
 
+use crate::exercise::live::ATTEMPT_PICTURE;
 use crate::exercise::{LiveExercise, ToolFrame};
 use camera_input::{preview_camera, wheel_steps};
 use frame_times::{FrameTime, FrameTimes};
@@ -58,9 +59,6 @@ pub const ATTEMPTS_DIR: &str = "out/exercises";
 
 /// The results history preview attempts are appended to (`incise exercise`'s default).
 pub const HISTORY_FILE: &str = "results/history.jsonl";
-
-/// Size of the report's pictures of a preview attempt.
-const ATTEMPT_PICTURE: ImageSize = ImageSize(960, 540);
 
 /// Open the preview window and run until it is closed (or `--frames` are done).
 pub fn run(opts: PreviewOptions) -> Result<()> {

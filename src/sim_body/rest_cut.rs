@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 use incise_sim::mass_spring::MassSpringModel;
-use incise_sim::mesh::TET_FACES;
+use incise_sim::nakao_cut::measure::cut_faces;
 
 /// A body's cut at rest.
 #[derive(Debug, Clone, PartialEq)]
@@ -13,6 +13,13 @@ pub enum RestCut {
     Released(Vec<bool>),
     /// The faces of the cut surface (both sides of the wound), at rest.
     Faces(Vec<RestCutFace>),
+}
+
+impl RestCut {
+    /// The tets an XPBD `solver` has released (its cut's live flags, negated).
+    pub fn released_of(solver: &incise_sim::Solver) -> RestCut {
+        RestCut::Released(solver.cut().live().iter().map(|l| !l).collect())
+    }
 }
 
 /// One face of a cut surface at rest.
@@ -37,16 +44,7 @@ impl RestCutFace {
 /// positions (new nodes at their interpolated ones, PHYSICS.md §2.4).
 pub fn cut_faces_at_rest(model: &MassSpringModel) -> RestCut {
     let x = model.reference_positions();
-    let faces = model
-        .tets()
-        .iter()
-        .zip(model.tet_cut_faces())
-        .enumerate()
-        .flat_map(|(t, (tet, &flags))| {
-            (0..4)
-                .filter(move |f| flags & (1 << f) != 0)
-                .map(move |f| (t, TET_FACES[f].map(|l| tet[l])))
-        })
+    let faces = cut_faces(model)
         .map(|(t, face)| RestCutFace {
             corners: face.map(|i| x[i as usize]),
             tet: t as u32,

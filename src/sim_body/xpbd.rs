@@ -283,8 +283,7 @@ impl SimBody for XpbdBody {
     }
 
     fn rest_cut(&self) -> Option<RestCut> {
-        let live = self.body.solver().cut().live();
-        Some(RestCut::Released(live.iter().map(|l| !l).collect()))
+        Some(RestCut::released_of(self.body.solver()))
     }
 
     fn inject(&mut self, fault: Fault) -> Result<()> {

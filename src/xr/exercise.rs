@@ -17,16 +17,13 @@ use incise_xr::{RenderDevice, Renderer, RgbaImage, SurfaceLine};
 use serde::Serialize;
 
 use super::xr_body::XrBody;
+use crate::exercise::live::{ATTEMPT_PICTURE, attempt_view_pictures};
 use crate::exercise::{
     AttemptBody, LiveExercise, LoadedExercise, PlanDecal, PoseRecording, ToolFrame,
 };
-use crate::pictures::screenshots::{ImageSize, Screenshots};
-use crate::pictures::view_pictures::ViewPictures;
+use crate::pictures::screenshots::Screenshots;
 use crate::sim_body::Body;
 use crate::sim_body::recorded::RecordedBody;
-
-/// Size of the report's before/after pictures, pixels.
-const PICTURE: ImageSize = ImageSize(960, 540);
 
 /// What became of one attempt in the session (in `xr_report.json`).
 #[derive(Debug, Clone, Serialize)]
@@ -191,17 +188,23 @@ impl XrExercise<Body> {
     /// are rendered on `dev`.
     pub fn start(&mut self, xr: &mut XrBody, skin: &Skin, dev: &RenderDevice) -> Result<()> {
         self.card_changed |= self.card.take().is_some();
-        let pictures = Screenshots::new(Some(dev), xr.solver(), skin, PICTURE, Default::default())
-            .map(|s| {
-                let s = s
-                    .with_tool(xr.scalpel())
-                    .with_decal(self.live.decal.clone());
-                match xr.body {
-                    Body::Gpu(_) => s.with_shared_device(),
-                    Body::Cpu(_) => s,
-                }
-            })
-            .map_err(|e| format!("{e:#}"));
+        let pictures = Screenshots::new(
+            Some(dev),
+            xr.solver(),
+            skin,
+            ATTEMPT_PICTURE,
+            Default::default(),
+        )
+        .map(|s| {
+            let s = s
+                .with_tool(xr.scalpel())
+                .with_decal(self.live.decal.clone());
+            match xr.body {
+                Body::Gpu(_) => s.with_shared_device(),
+                Body::Cpu(_) => s,
+            }
+        })
+        .map_err(|e| format!("{e:#}"));
         self.live.start(&mut self.stroke, &mut xr.body, pictures)
     }
 
@@ -217,11 +220,7 @@ impl XrExercise<RecordedBody> {
     /// taken of its tet view offscreen.
     pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
         self.card_changed |= self.card.take().is_some();
-        let heat_map = incise_xr::Overlays {
-            stress: true,
-            ..Default::default()
-        };
-        let pictures = ViewPictures::new(PICTURE, heat_map).map_err(|e| format!("{e:#}"));
+        let pictures = attempt_view_pictures();
         self.live.start(&mut self.stroke, body, pictures)
     }
 }

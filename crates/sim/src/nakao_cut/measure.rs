@@ -53,16 +53,22 @@ pub fn cut_surface_area(model: &MassSpringModel) -> f64 {
 
 /// The cut-surface triangles (outward wound, node indices).
 pub fn cut_triangles(model: &MassSpringModel) -> Vec<[u32; 3]> {
+    cut_faces(model).map(|(_, face)| face).collect()
+}
+
+/// Every tet face the cutter opened: its tet's index and its corners (outward wound,
+/// node indices).
+pub fn cut_faces(model: &MassSpringModel) -> impl Iterator<Item = (usize, [u32; 3])> + '_ {
     model
         .tets()
         .iter()
         .zip(model.tet_cut_faces())
-        .flat_map(|(tet, &flags)| {
+        .enumerate()
+        .flat_map(|(t, (tet, &flags))| {
             (0..4)
                 .filter(move |f| flags & (1 << f) != 0)
-                .map(move |f| TET_FACES[f].map(|l| tet[l]))
+                .map(move |f| (t, TET_FACES[f].map(|l| tet[l])))
         })
-        .collect()
 }
 
 /// Width of the wound near `centre`: the mean distance between the two copies of every
