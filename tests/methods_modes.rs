@@ -563,3 +563,25 @@ fn a_nakao_headset_session_pauses_draws_the_blade_and_moves_its_tray() {
         mean_column(&e96, common::pixels::is_tissue) - mean_column(&e72, common::pixels::is_tissue);
     assert!(shift > 5.0, "the organ moved {shift:.1} px with the tray");
 }
+
+/// A on a Nakao headset session (no exercise) starts the scene over, as on an XPBD one:
+/// the plate loaded afresh, its script holding the blade again (from 0.2 s of the fresh
+/// body's time).
+#[test]
+fn a_starts_a_nakao_headset_session_over() {
+    let dir = temp_dir("mh-nakao-reset");
+    // The scene's cut (0.2–0.9 s) done, then A at 1.0 s and 0.15 s more.
+    let path = script(&dir, 1.15, "buttons: [(1.0, A)],");
+    let out = dir.join("out");
+    if headset("config/plate_cut_nakao.ron", &path, &out).is_none() {
+        return;
+    }
+    let r = report(&out);
+    // The report is the fresh body's: about 15 frames, nothing cut yet.
+    assert_eq!(r["nakao"]["nodes_added"], 0, "{}", r["nakao"]);
+    let frames = r["frames"].as_array().map_or(0, Vec::len);
+    assert!(
+        (5..=25).contains(&frames),
+        "{frames} frames in the fresh body's report"
+    );
+}

@@ -71,17 +71,17 @@ struct Session {
     /// A Nakao exercise: its plan drawn, attempts recorded from the controller and
     /// scored on the body's cut surface (the body stepped in the frame).
     exercise: Option<HeadsetExercise>,
+    /// What A opens afresh: the scene, the output folder its report is written to, where
+    /// the body is stepped and how its frames are slowed.
+    reopen: (PathBuf, PathBuf, SimMode, Duration),
 }
 
-/// A method session's exercise, with what it needs to reload the scene for a new attempt.
+/// A method session's exercise.
 pub struct HeadsetExercise {
     /// The exercise and its attempts.
     pub live: XrExercise<RecordedBody>,
     /// The blade's last tracked pose (held, lifted, while the controller is untracked).
     pose: ToolPose,
-    /// Where the session writes and how its body frames are slowed: what a new attempt's
-    /// fresh body is opened with.
-    reload: (PathBuf, Duration),
 }
 
 impl HeadsetExercise {
@@ -95,7 +95,6 @@ impl HeadsetExercise {
                 position: Vec3::new(0.0, 0.0, 1.0),
                 rotation: Quat::IDENTITY,
             },
-            reload: (PathBuf::new(), Duration::ZERO),
         })
     }
 }
@@ -181,10 +180,8 @@ fn run_on(
         previous: None,
         given_up: 0.0,
         exercise,
+        reopen: (scene.to_path_buf(), out.to_path_buf(), mode, sim.slow),
     };
-    if let Some(ex) = &mut s.exercise {
-        ex.reload = (out.to_path_buf(), sim.slow);
-    }
     let curve = HapticCurve::default();
     let display = DisplayOptions {
         max_frames: sim.frames,
@@ -386,21 +383,22 @@ impl HeadsetSim for Session {
         self.start_attempt()
     }
 
-    /// A pressed in an exercise: an attempt the blade touched is finished (its card
-    /// shown); otherwise the scene is loaded afresh and a new attempt starts. Outside an
-    /// exercise A does nothing (the body's report covers one body).
+    /// A pressed: in an exercise an attempt the blade touched is finished (its card
+    /// shown); otherwise the scene starts over, loaded afresh (an exercise's new attempt
+    /// starts on it; outside one the scene's script holds the tool again).
     fn on_a(&mut self) -> Result<()> {
-        let (Some(ex), Stepper::InFrame { body, .. }) = (&mut self.exercise, &self.stepper) else {
-            return Ok(());
-        };
-        if !ex.live.on_a(body)? {
+        if let (Some(ex), Stepper::InFrame { body, .. }) = (&mut self.exercise, &self.stepper)
+            && !ex.live.on_a(body)?
+        {
             return Ok(());
         }
-        let scene = ex.live.exercise().scene_path.clone();
-        let (out, slow) = ex.reload.clone();
-        (self.stepper, self.drawing) = Stepper::open(&scene, &out, SimMode::InFrame, slow)?;
+        let (scene, out, mode, slow) = &self.reopen;
+        (self.stepper, self.drawing) = Stepper::open(scene, out, *mode, *slow)?;
         self.renderer = renderer_for(&self.dev.0, self.dev.1, &self.drawing);
-        ex.live.renderer_replaced();
+        if let Some(ex) = &mut self.exercise {
+            ex.live.renderer_replaced();
+        }
+        self.hand = false;
         // The fresh body's time 0 is the next display frame's.
         (self.start, self.previous, self.given_up) = (None, None, 0.0);
         self.start_attempt()
