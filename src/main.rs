@@ -5,7 +5,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use incise::bench::{self, realtime as bench_realtime, render as bench_render};
 use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
-use incise::pictures::screenshots;
+use incise::pictures::render_command;
 use incise::pictures::screenshots::ImageSize;
 use incise::preview::{self, PreviewOptions};
 use incise::run::{RunOptions, run_scene};
@@ -153,7 +153,7 @@ fn main() -> ExitCode {
             size,
             overlay,
             device,
-        } => screenshots::render_frame(&scene, frame, &out, size, &overlay, device)
+        } => render_command::render_frame(&scene, frame, &out, size, &overlay, device)
             .map(|()| println!("wrote {}", out.display())),
         Command::Compare {
             scene,

@@ -7,8 +7,8 @@ use std::collections::HashSet;
 use glam::DVec3;
 use incise_sim::TetMesh;
 
-use super::metrics::{Band, for_window};
-use super::plan::Plan;
+use super::band::Band;
+use super::plan::{Plan, for_window};
 use crate::sim_body::RestCutFace;
 
 /// A released boundary face counts as part of the surface trace when its outward normal

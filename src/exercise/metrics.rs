@@ -7,9 +7,10 @@ use incise_sim::TetMesh;
 use incise_sim::xpbd::FrameStats;
 use serde::Serialize;
 
+use super::band::Band;
 use super::cut_reading::{released_cut, surface_cut};
 use super::model::Exercise;
-use super::plan::Plan;
+use super::plan::{Plan, for_window};
 use crate::report::FrameData;
 use crate::sim_body::RestCut;
 
@@ -170,34 +171,6 @@ pub fn compute(
     }
 }
 
-/// The tolerance band and the resolution lengths of the metrics.
-pub(super) struct Band {
-    /// Lateral tolerance `w`, m.
-    pub lateral: f64,
-    /// Target depth `d*`, m.
-    pub target: f64,
-    /// Deepest allowed cut `d* + δ`, m.
-    pub max_depth: f64,
-    /// Mean tet edge `h`, m.
-    pub tet_edge: f64,
-    /// Samples within this arc length of a cut count as cut (a tet spans about one
-    /// edge): `h/2`, m.
-    pub window: f64,
-}
-
-impl Band {
-    fn of(exercise: &Exercise, mesh: &TetMesh) -> Band {
-        let tet_edge = mesh.mean_edge_length() as f64;
-        Band {
-            lateral: exercise.tolerance.lateral as f64,
-            target: exercise.depth as f64,
-            max_depth: (exercise.depth + exercise.tolerance.depth) as f64,
-            tet_edge,
-            window: 0.5 * tet_edge,
-        }
-    }
-}
-
 /// The tool figures of an attempt's frames.
 struct ToolFigures {
     max_force: f64,
@@ -233,18 +206,4 @@ impl ToolFigures {
             duration,
         }
     }
-}
-
-/// Call `f` for every sample within `window` arc length of sample `centre`.
-pub(super) fn for_window(plan: &Plan, centre: usize, window: f64, mut f: impl FnMut(usize)) {
-    let s = plan.samples[centre].s;
-    let lo = plan.samples[..centre]
-        .iter()
-        .rposition(|p| s - p.s > window)
-        .map_or(0, |i| i + 1);
-    let hi = plan.samples[centre..]
-        .iter()
-        .position(|p| p.s - s > window)
-        .map_or(plan.samples.len(), |i| centre + i);
-    (lo..hi).for_each(&mut f);
 }

@@ -4,6 +4,7 @@
 //! local history of attempts. Definitions: docs/scoring.md.
 
 mod attempt;
+mod band;
 mod cut_reading;
 mod decal;
 mod history;
@@ -15,6 +16,7 @@ mod plan;
 mod pose_recording;
 mod reference;
 mod reference_blade;
+mod reference_style;
 mod report_html;
 mod result;
 mod result_card;
@@ -31,7 +33,8 @@ pub use metrics::{Metrics, STROKE_GAP_FRAMES, ToolFrame, compute as compute_metr
 pub use model::{Exercise, PassThresholds, Tolerance};
 pub use plan::{Plan, PlanCoords, PlanSample, RestSurface};
 pub use pose_recording::PoseRecording;
-pub use reference::{ReferenceStyle, reference_stroke, write_reference_stroke};
+pub use reference::{reference_stroke, write_reference_stroke};
+pub use reference_style::ReferenceStyle;
 pub use report_html::CutImages;
 pub use result::ExerciseResult;
 pub use result_card::{BANNER, CARD_SIZE, FAIL_COLOUR, PASS_COLOUR, Standing, render_card};

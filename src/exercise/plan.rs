@@ -170,6 +170,20 @@ impl Plan {
     }
 }
 
+/// Call `f` for every sample within `window` arc length of sample `centre`.
+pub(super) fn for_window(plan: &Plan, centre: usize, window: f64, mut f: impl FnMut(usize)) {
+    let s = plan.samples[centre].s;
+    let lo = plan.samples[..centre]
+        .iter()
+        .rposition(|p| s - p.s > window)
+        .map_or(0, |i| i + 1);
+    let hi = plan.samples[centre..]
+        .iter()
+        .position(|p| p.s - s > window)
+        .map_or(plan.samples.len(), |i| centre + i);
+    (lo..hi).for_each(&mut f);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,7 +7,7 @@ use glam::{DQuat, DVec3};
 use incise_scalpel::{PoseKey, Stroke};
 
 use super::load::LoadedExercise;
-use super::reference::ReferenceStyle;
+use super::reference_style::ReferenceStyle;
 use crate::scene::MassSpringScene;
 use crate::sim_body::nakao_blade::Blade;
 

@@ -98,10 +98,11 @@ impl NakaoBody {
             frame: 0,
             total_volume,
             force: None,
-            coupling: ToolCoupling::of(&HapticConfig {
+            coupling: HapticConfig {
                 contact: ms.haptic_contact,
                 ..HapticConfig::default()
-            }),
+            }
+            .tool_coupling(),
             hand_stroke: None,
             reach,
             touched: false,

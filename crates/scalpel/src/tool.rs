@@ -7,10 +7,12 @@ use std::path::Path;
 use glam::{Quat, Vec2, Vec3};
 use incise_sim::contact::{ContactTool, ToolBox, ToolSphere};
 use incise_sim::ron_file;
+use parry3d::query::PointQuery;
 use parry3d::shape::Compound;
 
 use crate::error::{FieldError, FileError};
 use crate::ron_text;
+use crate::tool_body::{compound, to_parry};
 use crate::tool_spec::{SpherePlacement, ToolSpec};
 
 /// Most cutting spheres a tool places along its edge (a very fine tissue mesh with
@@ -82,7 +84,7 @@ impl Tool {
                 half_extents: v3(&b.half_extents),
             })
             .collect();
-        let body_shape = crate::tool_body::compound(&body);
+        let body_shape = compound(&body);
         Ok(Tool {
             name: spec.name.clone(),
             source: spec.source.clone(),
@@ -300,6 +302,20 @@ fn point_in_polygon(p: Vec2, poly: &[Vec2]) -> bool {
         }
     }
     inside
+}
+
+impl Tool {
+    /// The non-cutting body (blade flat and handle boxes) as a parry3d compound in the
+    /// tool frame, m.
+    pub fn body_shape(&self) -> &Compound {
+        &self.body_shape
+    }
+
+    /// Signed distance (m) from tool-frame point `p` to the body: positive outside,
+    /// negative inside (depth to the nearest face of the box containing it).
+    pub fn body_distance(&self, p: Vec3) -> f32 {
+        self.body_shape.distance_to_local_point(to_parry(p), false)
+    }
 }
 
 #[cfg(test)]

@@ -1,5 +1,5 @@
-//! The non-cutting body as a parry3d compound of cuboids, for distance queries outside the
-//! solver (placement checks, tests against the solver's own box distance).
+//! The non-cutting body as a parry3d compound of cuboids (the tool keeps it for distance
+//! queries outside the solver: placement checks, tests against the solver's own box distance).
 //!
 //! parry3d 0.31 is built on `glamx` (glam 0.33), not nalgebra, while this workspace uses
 //! glam 0.34: values cross the boundary as plain `f32` components.
@@ -7,10 +7,7 @@
 use glam::Vec3;
 use incise_sim::contact::ToolBox;
 use parry3d::math::{Pose, Rotation, Vector};
-use parry3d::query::PointQuery;
 use parry3d::shape::{Compound, Cuboid, SharedShape};
-
-use crate::tool::Tool;
 
 /// A workspace (glam 0.34) vector as a parry3d vector.
 pub(crate) fn to_parry(v: Vec3) -> Vector {
@@ -32,18 +29,4 @@ pub(crate) fn compound(boxes: &[ToolBox]) -> Compound {
         })
         .collect();
     Compound::new(parts)
-}
-
-impl Tool {
-    /// The non-cutting body (blade flat and handle boxes) as a parry3d compound in the
-    /// tool frame, m.
-    pub fn body_shape(&self) -> &Compound {
-        &self.body_shape
-    }
-
-    /// Signed distance (m) from tool-frame point `p` to the body: positive outside,
-    /// negative inside (depth to the nearest face of the box containing it).
-    pub fn body_distance(&self, p: Vec3) -> f32 {
-        self.body_shape.distance_to_local_point(to_parry(p), false)
-    }
 }

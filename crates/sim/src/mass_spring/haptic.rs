@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use glam::DVec3;
 
-use super::tool_coupling::ToolCoupling;
+use super::tool_coupling::{HapticContact, ToolCoupling};
 use super::{LocalLoop, LocalLoopParams, MassSpringModel, SystemClock};
 use crate::nakao_cut::{BladePose, CutParams, Cutter};
 
@@ -35,6 +35,14 @@ pub struct HapticConfig {
     pub cut: CutParams,
 }
 
+impl HapticConfig {
+    /// The tool's coupling these settings make: their contact, spring stiffness and
+    /// contact radius.
+    pub fn tool_coupling(&self) -> ToolCoupling {
+        ToolCoupling::new(self.contact, self.coupling, self.contact_radius)
+    }
+}
+
 impl Default for HapticConfig {
     fn default() -> Self {
         HapticConfig {
@@ -47,21 +55,6 @@ impl Default for HapticConfig {
             cut: CutParams::default(),
         }
     }
-}
-
-/// The coupling of the tool point to the tissue, both a virtual spring of stiffness
-/// [`HapticConfig::coupling`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum HapticContact {
-    /// To the node nearest the tip, within [`HapticConfig::contact_radius`]: pulls as well
-    /// as pushes (a blade held in the cut), and the force steps when the nearest node
-    /// changes (default; what the cutting runs use).
-    #[default]
-    NearestNode,
-    /// To a god object riding the surface (Zilles & Salisbury 1995, [`GodObject`]): a
-    /// probe pushes the surface in and feels it push back, never pulls, and cannot pass
-    /// through the body.
-    GodObject,
 }
 
 /// What the haptic thread last published.
@@ -177,7 +170,7 @@ fn run(mut model: MassSpringModel, config: HapticConfig, shared: &Shared) -> Mas
     let mut local = LocalLoop::new(config.local.clone(), SystemClock::default());
     let mut cutter = Cutter::new(config.cut.clone());
     let mut blade_seen: Option<BladePose> = None;
-    let mut couple = ToolCoupling::of(&config);
+    let mut couple = config.tool_coupling();
     let mut next = Instant::now() + period;
     let (mut loops, mut overruns, mut snapshots, mut cuts) = (0u64, 0u64, 0u64, 0u64);
     while !shared.stop.load(Ordering::Acquire) {
@@ -302,7 +295,7 @@ mod tests {
             contact,
             ..HapticConfig::default()
         };
-        let mut couple = ToolCoupling::of(&config);
+        let mut couple = config.tool_coupling();
         let mut local = LocalLoop::new(config.local.clone(), SystemClock::default());
         let h = 1.0 / config.rate_hz;
         let substeps = (h / m.stable_dt()).ceil().max(1.0) as u32;

@@ -23,7 +23,7 @@ mod tool_coupling;
 pub use adjacency::{ElementIndex, Rows};
 pub use axes::AxisMask;
 pub use god_object::{GodObject, ProxyContact, ProxySurface};
-pub use haptic::{HapticConfig, HapticContact, HapticFrame, HapticLoop};
+pub use haptic::{HapticConfig, HapticFrame, HapticLoop};
 pub use hierarchy::NodeHierarchy;
 pub use local_loop::{Clock, LocalLoop, LocalLoopParams, LoopStats, SystemClock};
 pub use model::{MassSpringModel, Spring};
@@ -33,6 +33,7 @@ pub use state::DynamicState;
 pub use stiffness::StiffnessLaw;
 pub use tension::Tension;
 pub use tet_tensor::TetTensor;
+pub use tool_coupling::HapticContact;
 pub use tool_coupling::ToolCoupling;
 
 pub(crate) use tet_tensor::edge_frames;

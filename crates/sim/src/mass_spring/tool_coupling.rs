@@ -6,8 +6,22 @@
 use glam::DVec3;
 
 use super::god_object::{GodObject, ProxySurface};
-use super::haptic::{HapticConfig, HapticContact};
 use super::{LocalLoop, MassSpringModel, SystemClock};
+
+/// The coupling of the tool point to the tissue, both a virtual spring of stiffness
+/// `HapticConfig::coupling`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum HapticContact {
+    /// To the node nearest the tip, within `HapticConfig::contact_radius`: pulls as well
+    /// as pushes (a blade held in the cut), and the force steps when the nearest node
+    /// changes (default; what the cutting runs use).
+    #[default]
+    NearestNode,
+    /// To a god object riding the surface (Zilles & Salisbury 1995, [`GodObject`]): a
+    /// probe pushes the surface in and feels it push back, never pulls, and cannot pass
+    /// through the body.
+    GodObject,
+}
 
 /// A tool's coupling: the settings and, for a god object, its proxy and the surface it
 /// rides (rebuilt when a cut changes the tets).
@@ -21,12 +35,13 @@ pub struct ToolCoupling {
 }
 
 impl ToolCoupling {
-    /// The coupling `config` sets up: its contact, spring stiffness and contact radius.
-    pub fn of(config: &HapticConfig) -> Self {
+    /// A coupling by `contact` with a spring of `stiffness`, N/m, reaching nodes within
+    /// `radius`, m (nearest-node contact).
+    pub fn new(contact: HapticContact, stiffness: f64, radius: f64) -> Self {
         ToolCoupling {
-            contact: config.contact,
-            stiffness: config.coupling,
-            radius: config.contact_radius,
+            contact,
+            stiffness,
+            radius,
             ..ToolCoupling::default()
         }
     }

@@ -6,7 +6,7 @@ use glam::{Mat3, Vec3};
 use super::lanes::{LANES, Lane, M3, V3};
 use super::rest_free_lanes::{TetLanes, project_rest_free_lanes};
 use super::shared_nodes::SharedNodes;
-use super::solver::TetSlot;
+use super::tet_slot::TetSlot;
 
 /// Project `slots` (tets of one colour, at most [`LANES`]) and store their volume
 /// multipliers in `lambdas`; tets that are not live are left as they are.

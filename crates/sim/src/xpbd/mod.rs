@@ -16,11 +16,13 @@ mod shared_nodes;
 mod solver;
 mod stability;
 mod strain;
+mod tet_constraint;
+mod tet_slot;
 
 pub use coloring::greedy_tet_colors;
 pub use frame::FrameStats;
 pub use neo_hookean::{
-    ConstraintPair, TetProjection, TetTerms, deformation_gradient, det_gradient, project_tet,
+    ConstraintPair, TetProjection, TetTerms, deformation_gradient, det_gradient,
 };
 pub use params::{CpuKernel, DEFAULT_RELEASE_INTERVAL, SolverError, SolverParams};
 pub use release_schedule::release_checks;
@@ -28,3 +30,4 @@ pub use rest_free::{J_MIN, log_volume, shape_constraint, shape_energy, volume_co
 pub use solver::{NodeKind, Solver};
 pub use stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
 pub use strain::{Strain, cofactor, displacement_gradient, log1p_excess};
+pub use tet_constraint::project_tet;

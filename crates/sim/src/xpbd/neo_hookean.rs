@@ -1,7 +1,8 @@
 //! Projection of the Neo-Hookean tet constraints (PHYSICS.md §1.2, Macklin & Müller 2021).
 //!
-//! Two constraint pairs ([`ConstraintPair`]): the rest-free pair (default,
-//! [`super::rest_free`]) and the seed paper's γ-shifted pair, written here:
+//! Two constraint pairs ([`ConstraintPair`], chosen per tet by
+//! [`super::tet_constraint`]): the rest-free pair (default, [`super::rest_free`]) and the
+//! seed paper's γ-shifted pair, written here:
 //! `C_D = ‖F‖_F` with compliance `1/(μV)` and `C_H = det F − γ`, `γ = 1 + μ/λ`, with
 //! compliance `1/(λV)`. The CPU reference solves both constraints of a tet together (a 2×2
 //! system, as Macklin & Müller 2021 §5 recommend): because `∇C_H ∥ ∇C_D` at rest, the
@@ -94,28 +95,10 @@ pub(super) fn weighted_dot(w: &[f32; 4], a: &[Vec3; 4], b: &[Vec3; 4]) -> f32 {
     w[0] * a[0].dot(b[0]) + w[1] * a[1].dot(b[1]) + w[2] * a[2].dot(b[2]) + w[3] * a[3].dot(b[3])
 }
 
-/// Project both constraints of `pair` of one tet in place (`x` holds the nodes'
-/// displacements from rest, see [`deformation_gradient_from_displacement`]); returns the
-/// volume multiplier of this substep (the seed's hydrostatic stress, PHYSICS.md §1.3).
-#[inline]
-pub fn project_tet(
-    x: &mut [Vec3; 4],
-    w: &[f32; 4],
-    t: &TetTerms,
-    mode: TetProjection,
-    pair: ConstraintPair,
-) -> f32 {
-    match (pair, mode) {
-        (ConstraintPair::RestFree, _) => super::rest_free::project_rest_free(x, w, t, mode),
-        (ConstraintPair::GammaShifted, TetProjection::Coupled) => project_coupled(x, w, t),
-        (ConstraintPair::GammaShifted, TetProjection::Sequential) => project_sequential(x, w, t),
-    }
-}
-
 /// Coupled 2×2 XPBD step for (C_H, C_D) with λ reset each substep:
 /// `[S_HH+α̃_H, S_HD; S_HD, S_DD+α̃_D] Δλ = −C`, `x_i += w_i (∇_i C_H Δλ_H + ∇_i C_D Δλ_D)`.
 // PHYSICS.md §1.2, XPBD update (block form of Δλ = (−C − α̃λ)/(Σ w|∇C|² + α̃) with λ = 0).
-fn project_coupled(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
+pub(super) fn project_coupled(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
     let f = deformation_gradient_from_displacement(x, &t.dm_inv);
     let c_h = f.determinant() - t.gamma;
     let g_h = vertex_gradients(det_gradient(&f), &t.dm_inv);
@@ -159,7 +142,7 @@ pub(super) fn apply_pair(x: &mut [Vec3; 4], w: &[f32; 4], h: PairTerm<'_>, d: Pa
 }
 
 /// H then D, each a scalar XPBD step (the form written in PHYSICS.md §1.2).
-fn project_sequential(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
+pub(super) fn project_sequential(x: &mut [Vec3; 4], w: &[f32; 4], t: &TetTerms) -> f32 {
     let f = deformation_gradient_from_displacement(x, &t.dm_inv);
     let g_h = vertex_gradients(det_gradient(&f), &t.dm_inv);
     let dl_h = apply_scalar(x, w, &g_h, f.determinant() - t.gamma, t.alpha_h);
@@ -232,33 +215,9 @@ mod tests {
     fn coupled_projection_keeps_the_rest_state_of_a_tet() {
         // μ = λ: α̃_H = α̃_D, γ = 2. Displacements start at zero (the rest state).
         let mut u = [Vec3::ZERO; 4];
-        project_tet(
-            &mut u,
-            &[1.0; 4],
-            &terms(0.5, 2.0),
-            TetProjection::Coupled,
-            ConstraintPair::GammaShifted,
-        );
+        project_coupled(&mut u, &[1.0; 4], &terms(0.5, 2.0));
         for a in &u {
             assert!(a.length() < 1e-6, "a node moved by {a}");
-        }
-    }
-
-    #[test]
-    fn projection_conserves_momentum_with_equal_masses() {
-        let mut x = [
-            Vec3::ZERO,
-            Vec3::new(1.3, 0.1, 0.0),
-            Vec3::Y,
-            Vec3::new(0.0, 0.2, 0.7),
-        ];
-        let before: Vec3 = x.iter().sum();
-        for mode in [TetProjection::Coupled, TetProjection::Sequential] {
-            for pair in [ConstraintPair::GammaShifted, ConstraintPair::RestFree] {
-                project_tet(&mut x, &[2.0; 4], &terms(0.1, 1.5), mode, pair);
-            }
-            let after: Vec3 = x.iter().sum();
-            assert!((after - before).length() < 1e-5);
         }
     }
 
@@ -274,13 +233,7 @@ mod tests {
             gamma: 1.0,
         };
         for _ in 0..20 {
-            project_tet(
-                &mut x,
-                &[1.0; 4],
-                &t,
-                TetProjection::Coupled,
-                ConstraintPair::GammaShifted,
-            );
+            project_coupled(&mut x, &[1.0; 4], &t);
         }
         let det = deformation_gradient_from_displacement(&x, &Mat3::IDENTITY).determinant();
         assert!((det - 1.0).abs() < 1e-3, "det {det}");

@@ -10,11 +10,13 @@ use rayon::prelude::*;
 use super::coloring::greedy_tet_colors;
 use super::lane_pass;
 use super::neo_hookean::{
-    ConstraintPair, TetProjection, TetTerms, deformation_gradient_from_displacement, project_tet,
+    ConstraintPair, TetProjection, TetTerms, deformation_gradient_from_displacement,
 };
 use super::release_schedule::release_checks;
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
+use super::tet_constraint::project_tet;
+use super::tet_slot::TetSlot;
 use super::{CpuKernel, FrameStats, SolverError, SolverParams};
 use crate::contact::{ContactTool, CutZone, ToolMotion, ToolPose, project_node};
 use crate::cutting::{CutState, ReleaseEvent};
@@ -38,14 +40,6 @@ pub enum NodeKind {
     Grabbed(u32),
     /// No live tet left: frozen and hidden.
     Retired,
-}
-
-/// Packed per-tet data in colour order: what one projection reads.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct TetSlot {
-    pub(crate) nodes: [u32; 4],
-    pub(crate) terms: TetTerms,
-    pub(crate) live: bool,
 }
 
 /// Solver state for one soft body.

@@ -1,0 +1,193 @@
+//! The layout rule of the developers' guide: no source file imports a file that imports
+//! it, directly or around a longer circle, in the app and in each library crate. A file's
+//! imports are the modules its `crate::…` and `super::…` paths name (in `use` lines and
+//! inline, comments and its `#[cfg(test)] mod tests` left out), and a `mod.rs`'s
+//! `use child::…` lines; each path is resolved to the longest module prefix that is a
+//! file.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+/// A module path: `["xr", "frame_loop"]` for `src/xr/frame_loop.rs`; `[]` for lib.rs.
+type Module = Vec<String>;
+
+/// Every `.rs` file under `root` by module path, with its source.
+fn modules(root: &Path) -> BTreeMap<Module, String> {
+    let mut out = BTreeMap::new();
+    let mut dirs = vec![root.to_path_buf()];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let rel = path.strip_prefix(root).unwrap().with_extension("");
+            let mut m: Module = rel.iter().map(|c| c.to_string_lossy().into()).collect();
+            if matches!(m.last().map(String::as_str), Some("mod" | "lib" | "main")) {
+                m.pop();
+            }
+            out.insert(m, std::fs::read_to_string(&path).unwrap());
+        }
+    }
+    out
+}
+
+/// `src` without comments and without its test module (from `#[cfg(test)]` on).
+fn code(src: &str) -> String {
+    let src = src.split("#[cfg(test)]").next().unwrap();
+    src.lines()
+        .map(|l| l.split("//").next().unwrap())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The module paths `text` names after each `crate::` or `super::` (a `{a, b::c}` group
+/// expanded one level), relative to the crate root, for a file of module `m`.
+fn named_paths(text: &str, m: &Module) -> Vec<Module> {
+    let mut out = Vec::new();
+    for (head, prefix) in [
+        ("crate::", Vec::new()),
+        ("super::", m[..m.len().saturating_sub(1)].to_vec()),
+    ] {
+        for (at, _) in text.match_indices(head) {
+            let before = text[..at].chars().next_back();
+            if before.is_some_and(|c| c.is_alphanumeric() || c == '_') {
+                continue;
+            }
+            let rest = &text[at + head.len()..];
+            let path: String = rest
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':')
+                .collect();
+            let mut base = prefix.clone();
+            base.extend(path.split("::").filter(|s| !s.is_empty()).map(String::from));
+            out.push(base.clone());
+            if let Some(group) = rest[path.len()..].strip_prefix('{') {
+                for item in group.split('}').next().unwrap().split(',') {
+                    let item = item.split(" as ").next().unwrap().trim();
+                    if !item.is_empty() && item != "self" {
+                        let mut p = base.clone();
+                        p.extend(item.split("::").map(String::from));
+                        out.push(p);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The files each file imports.
+fn imports(files: &BTreeMap<Module, String>) -> BTreeMap<Module, BTreeSet<Module>> {
+    let resolve = |p: &Module| {
+        (0..=p.len())
+            .rev()
+            .map(|n| p[..n].to_vec())
+            .find(|q| files.contains_key(q))
+    };
+    files
+        .iter()
+        .map(|(m, src)| {
+            let text = code(src);
+            let mut paths = named_paths(&text, m);
+            // A mod.rs's (or lib.rs's) `use child::…`.
+            for line in text.lines().filter_map(|l| l.trim().strip_prefix("use ")) {
+                if let Some((first, _)) = line.split_once("::") {
+                    let mut p = m.clone();
+                    p.push(first.to_string());
+                    paths.push(p);
+                }
+            }
+            let targets = paths
+                .iter()
+                .filter_map(resolve)
+                .filter(|t| t != m)
+                .collect();
+            (m.clone(), targets)
+        })
+        .collect()
+}
+
+/// A circle of imports, if there is one: the files around it, the first repeated last.
+fn circle(edges: &BTreeMap<Module, BTreeSet<Module>>) -> Option<Vec<Module>> {
+    fn visit(
+        m: &Module,
+        edges: &BTreeMap<Module, BTreeSet<Module>>,
+        path: &mut Vec<Module>,
+        done: &mut BTreeSet<Module>,
+    ) -> Option<Vec<Module>> {
+        if let Some(i) = path.iter().position(|p| p == m) {
+            let mut c = path[i..].to_vec();
+            c.push(m.clone());
+            return Some(c);
+        }
+        if !done.insert(m.clone()) {
+            return None;
+        }
+        path.push(m.clone());
+        for t in edges.get(m).into_iter().flatten() {
+            if let Some(c) = visit(t, edges, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        None
+    }
+    let mut done = BTreeSet::new();
+    edges
+        .keys()
+        .find_map(|m| visit(m, edges, &mut Vec::new(), &mut done))
+}
+
+fn show(c: &[Module]) -> String {
+    c.iter()
+        .map(|m| {
+            if m.is_empty() {
+                "lib".into()
+            } else {
+                m.join("/")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" -> ")
+}
+
+#[test]
+fn no_file_imports_a_file_that_imports_it() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for src in [
+        "src",
+        "crates/sim/src",
+        "crates/scalpel/src",
+        "crates/xr/src",
+    ] {
+        let files = modules(&root.join(src));
+        assert!(files.len() > 5, "{src}: no sources found");
+        if let Some(c) = circle(&imports(&files)) {
+            panic!("{src}: a circle of imports: {}", show(&c));
+        }
+    }
+}
+
+#[test]
+fn a_circle_of_imports_is_found() {
+    let files: BTreeMap<Module, String> = [
+        (vec![], "mod a;\nmod b;\nmod c;".to_string()),
+        (vec!["a".into()], "use crate::b::Thing;".into()),
+        (vec!["b".into()], "use super::{c::Other, x};".into()),
+        (
+            vec!["c".into()],
+            "fn f() { crate::a::go() } // crate::b".into(),
+        ),
+    ]
+    .into();
+    let c = circle(&imports(&files)).expect("the circle a -> b -> c -> a");
+    assert_eq!(show(&c), "a -> b -> c -> a");
+    let mut cut = files.clone();
+    cut.insert(vec!["c".into()], "// crate::a::go()".into());
+    assert_eq!(circle(&imports(&cut)), None, "a comment is not an import");
+}
