@@ -15,6 +15,7 @@ use common::pixels::{assert_devices_agree, is_cut, is_tissue, projected_box, sce
 use common::temp_dir;
 
 use std::io::{BufRead, BufReader};
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 use incise_xr::RgbaImage;
@@ -110,8 +111,10 @@ fn untooled_plate(dir: &std::path::Path) -> std::path::PathBuf {
     path
 }
 
-#[test]
-fn a_left_drag_in_the_window_cuts_the_tissue() {
+/// Run the bash `script` (which drives the window with xdotool) under Xvfb in `cwd`,
+/// runtime files in `dir`; its output when it succeeded, `None` (said why) when xvfb-run,
+/// xdotool or a GPU adapter is missing and the GPU is not required.
+fn xdotool_session(script: &str, cwd: &Path, dir: &Path) -> Option<std::process::Output> {
     let have = |tool: &str| {
         Command::new("which")
             .arg(tool)
@@ -124,8 +127,25 @@ fn a_left_drag_in_the_window_cuts_the_tissue() {
             "INCISE_REQUIRE_GPU=1 but xvfb-run or xdotool is missing"
         );
         eprintln!("skipping: xvfb-run or xdotool is not installed");
-        return;
+        return None;
     }
+    let o = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1024x768x24", "bash", "-c", script])
+        .current_dir(cwd)
+        .env("XDG_RUNTIME_DIR", dir)
+        .output()
+        .expect("xvfb-run runs");
+    let err = String::from_utf8_lossy(&o.stderr);
+    if !o.status.success() && err.contains("no GPU adapter") && !required() {
+        eprintln!("skipping: {err}");
+        return None;
+    }
+    assert!(o.status.success(), "preview failed: {err}");
+    Some(o)
+}
+
+#[test]
+fn a_left_drag_in_the_window_cuts_the_tissue() {
     let dir = temp_dir("xvfb-drag");
     let scene = untooled_plate(&dir);
     let shot = dir.join("drag.png");
@@ -153,18 +173,10 @@ wait $P"#,
         scene = scene.display(),
         shot = shot.display(),
     );
-    let o = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24", "bash", "-c", &script])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("XDG_RUNTIME_DIR", &dir)
-        .output()
-        .expect("xvfb-run runs");
-    let err = String::from_utf8_lossy(&o.stderr);
-    if !o.status.success() && err.contains("no GPU adapter") && !required() {
-        eprintln!("skipping: {err}");
+    let cwd = Path::new(env!("CARGO_MANIFEST_DIR"));
+    if xdotool_session(&script, cwd, &dir).is_none() {
         return;
     }
-    assert!(o.status.success(), "preview failed: {err}");
     let img = RgbaImage::load_png(&shot).unwrap();
     // The cut surface's wet red (the skin is pink: much more green), in the 3D view.
     let cut = (0..img.height)
@@ -390,20 +402,6 @@ fn saved(dir: &std::path::Path, stem: &str, ext: &str) -> Vec<std::path::PathBuf
 /// Nakao plate to the scene as loaded.
 #[test]
 fn the_method_window_panel_saves_toggles_the_heat_map_and_resets() {
-    let have = |tool: &str| {
-        Command::new("which")
-            .arg(tool)
-            .output()
-            .is_ok_and(|o| o.status.success())
-    };
-    if !have("xvfb-run") || !have("xdotool") {
-        assert!(
-            !required(),
-            "INCISE_REQUIRE_GPU=1 but xvfb-run or xdotool is missing"
-        );
-        eprintln!("skipping: xvfb-run or xdotool is not installed");
-        return;
-    }
     let dir = temp_dir("xvfb-method-panel");
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut_nakao.ron");
     let last = dir.join("last.png");
@@ -426,18 +424,9 @@ wait $P"#,
         scene = scene.display(),
         last = last.display(),
     );
-    let o = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1024x768x24", "bash", "-c", &script])
-        .current_dir(&dir)
-        .env("XDG_RUNTIME_DIR", &dir)
-        .output()
-        .expect("xvfb-run runs");
-    let err = String::from_utf8_lossy(&o.stderr);
-    if !o.status.success() && err.contains("no GPU adapter") && !required() {
-        eprintln!("skipping: {err}");
+    let Some(o) = xdotool_session(&script, &dir, &dir) else {
         return;
-    }
-    assert!(o.status.success(), "preview failed: {err}");
+    };
     let vtu = saved(&dir.join("out/preview"), "plate_cut_nakao_f", ".vtu");
     assert_eq!(vtu.len(), 1, "no .vtu saved: {vtu:?}");
     assert!(

@@ -49,6 +49,20 @@ pub struct TetTerms {
     pub gamma: f32,
 }
 
+#[cfg(test)]
+impl TetTerms {
+    /// Terms of a rest tet with `Dm = I` and one compliance `alpha` for both constraints
+    /// (tests).
+    pub(super) fn uniform(alpha: f32, gamma: f32) -> TetTerms {
+        TetTerms {
+            dm_inv: Mat3::IDENTITY,
+            alpha_h: alpha,
+            alpha_d: alpha,
+            gamma,
+        }
+    }
+}
+
 /// Deformation gradient `F = Ds Dm⁻¹`.
 // PHYSICS.md §1.2, F = Ds Dm^-1.
 #[inline]
@@ -182,12 +196,7 @@ mod tests {
     use super::*;
 
     fn terms(alpha: f32, gamma: f32) -> TetTerms {
-        TetTerms {
-            dm_inv: Mat3::IDENTITY,
-            alpha_h: alpha,
-            alpha_d: alpha,
-            gamma,
-        }
+        TetTerms::uniform(alpha, gamma)
     }
 
     #[test]
