@@ -248,6 +248,12 @@ fn main() -> ExitCode {
                 last.map_or(0.0, |c| c.p99_ms),
                 if r.cycles.iter().all(|c| c.matches_first) { "matches" } else { "differs from" },
             );
+            if r.replayed_free_nodes > 0 {
+                println!(
+                    "later cuts replayed the first cut's free-node counts ({} localised frames)",
+                    r.replayed_free_nodes
+                );
+            }
             println!("report: {}", out.join("soak.json").display());
             if markdown {
                 print!("\n{}", incise::bench::soak::markdown(&r));

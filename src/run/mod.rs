@@ -50,6 +50,7 @@ fn open_options(opts: &RunOptions) -> OpenOptions {
         haptic_rate: opts.haptic_rate,
         quiet: opts.quiet,
         gpu: None,
+        free_nodes: None,
     }
 }
 
