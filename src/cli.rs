@@ -60,6 +60,11 @@ pub enum Command {
         /// Record the scalpel's pose every frame to this stroke file.
         #[arg(long)]
         record_stroke: Option<PathBuf>,
+        /// Mass-spring scenes: replay the free nodes of each localised frame of the run that
+        /// wrote this report.json instead of choosing them (a `Budget` scene's manager
+        /// chooses by wall time: the replay reproduces that run bit for bit).
+        #[arg(long, value_name = "REPORT")]
+        replay_localisation: Option<PathBuf>,
         /// Testing aid: destroy the GPU device just before frame N (the run must go on
         /// on the CPU with a warning in report.json).
         #[arg(long, value_name = "N")]

@@ -46,6 +46,7 @@ fn default_command() -> Command {
                 haptic_rate: None,
                 stroke: None,
                 record_stroke: None,
+                replay_localisation: None,
                 inject_gpu_loss_at: None,
                 inject_nan_at: None,
             }
@@ -78,6 +79,7 @@ fn main() -> ExitCode {
             haptic_rate,
             stroke,
             record_stroke,
+            replay_localisation,
             inject_gpu_loss_at,
             inject_nan_at,
         } => run_scene(&RunOptions {
@@ -93,6 +95,7 @@ fn main() -> ExitCode {
             haptic_rate,
             stroke,
             record_stroke,
+            replay_localisation,
             inject_gpu_loss_at,
             inject_nan_at,
             screenshot_decal: None,
@@ -248,6 +251,12 @@ fn main() -> ExitCode {
                 last.map_or(0.0, |c| c.p99_ms),
                 if r.cycles.iter().all(|c| c.matches_first) { "matches" } else { "differs from" },
             );
+            if r.replayed_free_nodes > 0 {
+                println!(
+                    "later cuts replayed the first cut's free-node counts ({} localised frames)",
+                    r.replayed_free_nodes
+                );
+            }
             println!("report: {}", out.join("soak.json").display());
             if markdown {
                 print!("\n{}", incise::bench::soak::markdown(&r));

@@ -330,3 +330,60 @@ fn chest_experiment_prints_the_papers_tables_beside_ours() {
     assert_eq!(csv.lines().count(), 1 + 3 * 20, "{csv}");
     assert!(out.join("table.md").exists() && out.join("results.json").exists());
 }
+
+/// `incise run --replay-localisation REPORT` on the budgeted chest (its manager choosing
+/// each frame's free nodes by wall time) replays the free nodes of the run that wrote
+/// REPORT, and with them its every figure, frame by frame; an XPBD scene refuses it.
+#[test]
+fn a_budgeted_run_replays_with_its_reports_localisation() {
+    let run = |out: &std::path::Path, replay: Option<&std::path::Path>| {
+        let mut args = vec![
+            "run",
+            "config/chest_incision_nakao.ron",
+            "--frames",
+            "20",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if let Some(r) = replay {
+            args.extend(["--replay-localisation", r.to_str().unwrap()]);
+        }
+        let o = incise(&args);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let json = std::fs::read_to_string(out.join("report.json")).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&json).unwrap();
+        // The figures the model's state gives, per frame (not its timings).
+        let keys = [
+            "level",
+            "free_nodes",
+            "volume_ratio",
+            "max_displacement",
+            "kinetic_energy",
+        ];
+        let frames: Vec<Vec<String>> = report["frames"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| keys.iter().map(|k| f[k].to_string()).collect())
+            .collect();
+        (frames, report["mesh"]["nodes"].clone())
+    };
+    let dir = temp_dir("replay-localisation");
+    let first = run(&dir.join("first"), None);
+    assert_eq!(first.0.len(), 20);
+    let replay = run(&dir.join("replay"), Some(&dir.join("first/report.json")));
+    assert_eq!(replay, first);
+    let o = incise(&[
+        "run",
+        "config/plate_cut.ron",
+        "--frames",
+        "1",
+        "--replay-localisation",
+        dir.join("first/report.json").to_str().unwrap(),
+        "--out",
+        dir.join("xpbd").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(text(&o.stderr).contains("--replay-localisation replays a mass-spring"));
+}

@@ -8,6 +8,9 @@
 //! cuts; transient peaks are reported), descriptors leak, or any cut leaves another result
 //! than the first (the same script must replay bit for bit): XPBD the released tets, Nakao
 //! the whole model (counts, tets, springs, positions), rheology positions and velocities.
+//! A localised Nakao scene's later cuts replay the first cut's free-node counts: the
+//! refresh-rate manager of a `Budget` scene picks them from wall time, which no two cuts
+//! share, and the model's bits follow the free set.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -15,6 +18,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, anyhow, bail};
 use serde::Serialize;
 
+use crate::report::{EdgeFrameStats, FrameData};
 use crate::scene::{ModelChoice, Scene, load_scene};
 use crate::sim_body::xpbd_device::gpu_context;
 use crate::sim_body::{DeviceChoice, Method, OpenOptions, Outcome, ToolInput, open};
@@ -77,6 +81,9 @@ pub struct SoakReport {
     pub seconds: f64,
     /// Every cycle.
     pub cycles: Vec<SoakCycle>,
+    /// Localised frames whose free-node counts the later cuts replayed from the first (a
+    /// Nakao scene with `Level` or `Budget` localisation; 0: nothing replayed).
+    pub replayed_free_nodes: usize,
     /// Sustained memory growth: the median RSS over the last third of the cuts after the
     /// second, over the RSS after the second, relative (0.05 = 5 %).
     pub rss_growth: f64,
@@ -113,11 +120,13 @@ pub(crate) fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[((sorted.len() - 1) as f64 * q).round() as usize]
 }
 
-/// One cut: what it left, where it ran and its frame times, ms.
+/// One cut: what it left, where it ran, its frame times, ms, and the free nodes of its
+/// localised frames (a Nakao scene's localisation; empty otherwise).
 struct Cut {
     device: String,
     outcome: Outcome,
     times: Vec<f64>,
+    free_nodes: Vec<usize>,
 }
 
 /// Refuse a scene whose script moves no tool (a soak of it would cut nothing).
@@ -147,11 +156,21 @@ fn cut_once(scene_path: &Path, opts: &OpenOptions) -> Result<Cut> {
     let (mut body, mut report) = open(&scene, scene_path, opts)?;
     let frames = (scene.duration as f64 / body.frame_dt()).round().max(1.0) as u64;
     let mut times = Vec::with_capacity(frames as usize);
+    let mut free_nodes = Vec::new();
     for f in 0..frames {
         let t0 = Instant::now();
-        body.step(&ToolInput::Script)
+        let frame = body
+            .step(&ToolInput::Script)
             .map_err(|e| anyhow!("{}: frame {f}: {e}", scene_path.display()))?;
         times.push(t0.elapsed().as_secs_f64() * 1e3);
+        if let FrameData::Edges(EdgeFrameStats {
+            level: Some(_),
+            free_nodes: Some(n),
+            ..
+        }) = frame
+        {
+            free_nodes.push(n);
+        }
     }
     body.finish(&mut report)?;
     let outcome = body
@@ -161,6 +180,7 @@ fn cut_once(scene_path: &Path, opts: &OpenOptions) -> Result<Cut> {
         device: body.device(),
         outcome,
         times,
+        free_nodes,
     })
 }
 
@@ -193,7 +213,8 @@ pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
         ModelChoice::MassSpring(_) => Method::Nakao,
         ModelChoice::Rheology(_) => Method::Rheology,
     };
-    let (cycles, device) = cut_for(opts, &open_options(&scene, opts.device)?, start)?;
+    let (cycles, device, replayed_free_nodes) =
+        cut_for(opts, &open_options(&scene, opts.device)?, start)?;
     let verdict = judge(&cycles);
     let report = SoakReport {
         scene: opts.scene.display().to_string(),
@@ -201,6 +222,7 @@ pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
         device,
         seconds: start.elapsed().as_secs_f64(),
         cycles,
+        replayed_free_nodes,
         rss_growth: verdict.rss_growth,
         rss_peak_growth: verdict.rss_peak_growth,
         fd_growth: verdict.fd_growth,
@@ -216,22 +238,28 @@ pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
 }
 
 /// Cut, reset and cut again until `opts.seconds` have passed since `start` (three cuts at
-/// least); every cut, and the device of the first.
+/// least), the later cuts replaying the first's free-node counts; every cut, and the
+/// device of the first and how many localised frames were replayed.
 fn cut_for(
     opts: &SoakOptions,
     open_opts: &OpenOptions,
     start: Instant,
-) -> Result<(Vec<SoakCycle>, String)> {
+) -> Result<(Vec<SoakCycle>, String, usize)> {
     let budget = Duration::from_secs_f64(opts.seconds.max(0.0));
     let mut cycles = Vec::new();
     let mut first: Option<Outcome> = None;
     let mut device = String::new();
+    let mut open_opts = open_opts.clone();
     while cycles.len() < 3 || start.elapsed() < budget {
         let Cut {
             device: dev,
             outcome,
             mut times,
-        } = cut_once(&opts.scene, open_opts)?;
+            free_nodes,
+        } = cut_once(&opts.scene, &open_opts)?;
+        if open_opts.free_nodes.is_none() && !free_nodes.is_empty() {
+            open_opts.free_nodes = Some(free_nodes);
+        }
         times.sort_by(f64::total_cmp);
         let matches_first = first.as_ref().is_none_or(|f| *f == outcome);
         if first.is_none() {
@@ -251,7 +279,8 @@ fn cut_for(
             matches_first,
         });
     }
-    Ok((cycles, device))
+    let replayed = open_opts.free_nodes.as_ref().map_or(0, Vec::len);
+    Ok((cycles, device, replayed))
 }
 
 /// The soak's figures and what failed.

@@ -77,6 +77,7 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
         haptic_rate: None,
         stroke: Some(opts.stroke.clone()),
         record_stroke: None,
+        replay_localisation: None,
         inject_gpu_loss_at: None,
         inject_nan_at: None,
         // The plan is drawn on XPBD bodies (a Nakao cut remodels the tets it is laid in).

@@ -71,6 +71,7 @@ pub fn measure(scene: &Path) -> Result<SceneFigure> {
         haptic_rate: None,
         stroke: None,
         record_stroke: None,
+        replay_localisation: None,
         inject_gpu_loss_at: None,
         inject_nan_at: None,
         screenshot_decal: None,

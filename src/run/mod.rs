@@ -9,7 +9,7 @@ pub mod options;
 pub use ending::{RunEnd, finish};
 pub use options::{CHECKPOINT_FRAMES, RunOptions, RunOutcome};
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 
 use crate::scene::{ModelChoice, load_scene};
 use crate::sim_body::{OpenOptions, open};
@@ -21,7 +21,16 @@ use frame_loop::FrameLoop;
 pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let scene = load_scene(&opts.scene)?;
     refuse_xpbd_only_options(&scene.model, opts)?;
-    let (body, report) = open(&scene, &opts.scene, &open_options(opts))?;
+    if opts.replay_localisation.is_some()
+        && (!matches!(scene.model, ModelChoice::MassSpring(_)) || opts.haptic_rate.is_some())
+    {
+        bail!(
+            "{}: --replay-localisation replays a mass-spring scene's frame-by-frame \
+             localisation (not with --haptic-rate)",
+            opts.scene.display()
+        );
+    }
+    let (body, report) = open(&scene, &opts.scene, &open_options(opts)?)?;
     let frames = opts
         .frames
         .unwrap_or_else(|| (scene.duration as f64 / body.frame_dt()).round().max(1.0) as u64);
@@ -41,16 +50,45 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     )
 }
 
-/// What of `opts` the body is opened with.
-fn open_options(opts: &RunOptions) -> OpenOptions {
-    OpenOptions {
+/// What of `opts` the body is opened with (a replayed localisation read from its report).
+fn open_options(opts: &RunOptions) -> Result<OpenOptions> {
+    let free_nodes = match &opts.replay_localisation {
+        Some(path) => Some(replayed_free_nodes(path)?),
+        None => None,
+    };
+    Ok(OpenOptions {
         threads: opts.threads,
         device: opts.device,
         stroke: opts.stroke.clone(),
         haptic_rate: opts.haptic_rate,
         quiet: opts.quiet,
         gpu: None,
-    }
+        free_nodes,
+    })
+}
+
+/// The free nodes of every localised frame (one with a `level`) of the report at `path`.
+fn replayed_free_nodes(path: &std::path::Path) -> Result<Vec<usize>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("--replay-localisation: reading {}", path.display()))?;
+    let report: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("--replay-localisation: {} is not JSON", path.display()))?;
+    let frames = report["frames"]
+        .as_array()
+        .ok_or_else(|| anyhow!("--replay-localisation: {} has no frames", path.display()))?;
+    frames
+        .iter()
+        .filter(|f| !f["level"].is_null())
+        .map(|f| {
+            f["free_nodes"].as_u64().map(|n| n as usize).ok_or_else(|| {
+                anyhow!(
+                    "--replay-localisation: {}: frame {} has a level but no free_nodes",
+                    path.display(),
+                    f["frame"]
+                )
+            })
+        })
+        .collect()
 }
 
 /// A stroke file drives the XPBD scalpel or the Nakao blade; recording a stroke is the

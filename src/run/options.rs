@@ -40,6 +40,9 @@ pub struct RunOptions {
     /// Record the tool's pose at every frame to this stroke file (replayable with
     /// `--stroke`, bit for bit).
     pub record_stroke: Option<PathBuf>,
+    /// Replay the free nodes of each localised frame of the Nakao run that wrote this
+    /// report.json (`--replay-localisation`) instead of choosing them.
+    pub replay_localisation: Option<PathBuf>,
     /// Fault injection for tests: lose the GPU device just before this frame.
     pub inject_gpu_loss_at: Option<u64>,
     /// Fault injection for tests: a NaN velocity on the first free node before this frame.

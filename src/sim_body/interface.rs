@@ -106,6 +106,11 @@ pub struct OpenOptions {
     pub stroke: Option<std::path::PathBuf>,
     /// Run a Nakao scene's local loop on its own thread at this rate, Hz (PHYSICS.md §2.6).
     pub haptic_rate: Option<f64>,
+    /// Replay a Nakao run's localisation: the free nodes of each localised frame of a
+    /// recorded run, in order, in place of the refresh-rate manager's (or the level's)
+    /// choices, so that a budgeted scene replays bit for bit (docs/reliability.md, Soak;
+    /// the frame-by-frame body: a `haptic_rate` thread chooses its own).
+    pub free_nodes: Option<Vec<usize>>,
     /// Print no notices.
     pub quiet: bool,
 }

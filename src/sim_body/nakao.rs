@@ -116,6 +116,15 @@ impl NakaoBody {
         self
     }
 
+    /// The body with its localised frames' free nodes replayed from a recorded run
+    /// ([`LocalLoop::replay`]) instead of chosen anew; a whole-mesh scene ignores them.
+    pub fn with_free_nodes(mut self, free_nodes: Vec<usize>) -> NakaoBody {
+        if let Some(l) = &mut self.local {
+            l.replay(free_nodes);
+        }
+        self
+    }
+
     /// The model as of the last completed frame.
     pub fn model(&self) -> &MassSpringModel {
         &self.model

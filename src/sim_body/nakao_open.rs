@@ -66,7 +66,10 @@ pub fn open(
             Box::new(NakaoHapticBody::spawn(model, ms, stroke, rate, frame_dt))
         }
         None => {
-            let body = NakaoBody::new(model, ms, frame_dt);
+            let mut body = NakaoBody::new(model, ms, frame_dt);
+            if let Some(free) = &opts.free_nodes {
+                body = body.with_free_nodes(free.clone());
+            }
             match &opts.stroke {
                 Some(file) => Box::new(body.with_stroke(incise_scalpel::load_stroke(file)?)),
                 None => Box::new(body),

@@ -128,3 +128,57 @@ fn free_set_follows_the_tool_and_the_manager_caps_it() {
     assert_eq!(b.free_nodes, 20);
     assert_eq!(local.manager().unwrap().free_nodes(), 20);
 }
+
+/// A scripted clock whose readings are `.1` s apart: a machine of another speed.
+struct PaceClock(std::cell::Cell<f64>, f64);
+
+impl Clock for PaceClock {
+    fn now(&self) -> f64 {
+        let t = self.0.get() + self.1;
+        self.0.set(t);
+        t
+    }
+}
+
+/// 40 budgeted loops of the tool crossing the cut plate, timed by a clock of `pace` s per
+/// reading, replaying `replay` when given: each loop's free nodes and the positions after.
+fn budgeted_run(pace: f64, replay: Option<&[usize]>) -> (Vec<usize>, Vec<DVec3>) {
+    let mut m = cut_plate();
+    let params = LocalLoopParams {
+        budget_ms: Some(0.3),
+        max_level: u32::MAX,
+        ..LocalLoopParams::default()
+    };
+    let mut local = LocalLoop::new(params, PaceClock(Default::default(), pace));
+    if let Some(counts) = replay {
+        local.replay(counts.iter().copied());
+    }
+    let dt = m.stable_dt();
+    let counts = (0..40)
+        .map(|k| {
+            let tip = DVec3::new(-0.04 + 0.002 * k as f64, 0.0011, 0.004);
+            local.frame(&mut m, tip, dt, 3).free_nodes
+        })
+        .collect();
+    (counts, m.positions().to_vec())
+}
+
+/// The manager picks the free set from the measured time, so two machines (clocks of
+/// another pace) end elsewhere; replaying the first run's free-node counts, the second
+/// reproduces it bit for bit (PHYSICS.md §2.5; docs/reliability.md, Soak).
+#[test]
+fn a_budgeted_loop_replaying_the_free_node_counts_reproduces_the_run() {
+    let (counts, fast) = budgeted_run(1e-5, None);
+    let (slow_counts, slow) = budgeted_run(4e-5, None);
+    assert_ne!(
+        counts, slow_counts,
+        "the clocks must make the manager choose otherwise"
+    );
+    assert_ne!(fast, slow);
+    let (replayed_counts, replayed) = budgeted_run(4e-5, Some(&counts));
+    assert_eq!(replayed_counts, counts);
+    let bits = |x: &[DVec3]| -> Vec<[u64; 3]> {
+        x.iter().map(|p| p.to_array().map(f64::to_bits)).collect()
+    };
+    assert_eq!(bits(&replayed), bits(&fast));
+}

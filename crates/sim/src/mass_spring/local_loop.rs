@@ -2,7 +2,11 @@
 //! the hierarchy to level d (or to the refresh-rate manager's node count), integrate the
 //! free nodes only, and feed the time of the force computation back to the manager. Each
 //! phase is timed apart (localise, force, integrate), as the paper's Figs. 15–17 split it.
+//! A recorded run's free-node counts can be replayed in place of the manager's choices
+//! ([`LocalLoop::replay`]): the manager picks them from wall time, so only a replay of
+//! them reproduces a budgeted run bit for bit.
 
+use std::collections::VecDeque;
 use std::time::Instant;
 
 use glam::DVec3;
@@ -93,6 +97,8 @@ pub struct LocalLoop<C: Clock = SystemClock> {
     manager: Option<RefreshRateManager>,
     previous: Vec<u32>,
     forces: Vec<DVec3>,
+    /// Free-node counts of a recorded run for the next loops, first first.
+    replay: VecDeque<usize>,
     clock: C,
 }
 
@@ -113,6 +119,7 @@ impl<C: Clock> LocalLoop<C> {
             manager,
             previous: Vec::new(),
             forces: Vec::new(),
+            replay: VecDeque::new(),
             clock,
         }
     }
@@ -125,6 +132,13 @@ impl<C: Clock> LocalLoop<C> {
     /// The refresh-rate manager, when a budget is set.
     pub fn manager(&self) -> Option<&RefreshRateManager> {
         self.manager.as_ref()
+    }
+
+    /// Build the next loops' hierarchies with these free-node counts (a recorded run's
+    /// [`LoopStats::free_nodes`], loop by loop) instead of the manager's or the fixed
+    /// level's; once they run out, the loop chooses again. The manager still measures.
+    pub fn replay(&mut self, free_nodes: impl IntoIterator<Item = usize>) {
+        self.replay = free_nodes.into_iter().collect();
     }
 
     /// One loop of `dt` with the tool at `tip`. Nodes that left the free set stop.
@@ -149,6 +163,9 @@ impl<C: Clock> LocalLoop<C> {
             Some(m) => (u32::MAX, m.free_nodes()),
             None => (self.params.max_level, self.params.max_nodes),
         };
+        // A recorded count k rebuilds the recorded free set: the breadth-first order is
+        // the same, and a build that ended below its cap with k nodes had no more to add.
+        let cap = self.replay.pop_front().unwrap_or(cap);
         self.hierarchy.build(model, root, level, cap);
         let left: Vec<u32> = self
             .previous
