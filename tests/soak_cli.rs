@@ -14,21 +14,41 @@ mod common;
 
 use common::{gpu_required, incise, temp_dir, text};
 
-fn soak(device: &str) {
-    let seconds = std::env::var("INCISE_SOAK_SECONDS").unwrap_or_else(|_| "0".into());
-    let out = temp_dir(&format!("soak-{device}"));
-    let o = incise(&[
+/// `incise soak SCENE --seconds SECONDS --device DEVICE --out OUT` (and `extra`): its
+/// output and soak.json's text (empty when it wrote none).
+fn run_soak(
+    scene: &str,
+    seconds: &str,
+    device: &str,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> (std::process::Output, String) {
+    let mut args = vec![
         "soak",
-        "config/plate_cut.ron",
+        scene,
         "--seconds",
-        &seconds,
+        seconds,
         "--device",
         device,
         "--out",
         out.to_str().unwrap(),
-        "--markdown",
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let o = incise(&args);
     let report = std::fs::read_to_string(out.join("soak.json")).unwrap_or_default();
+    (o, report)
+}
+
+fn soak(device: &str) {
+    let seconds = std::env::var("INCISE_SOAK_SECONDS").unwrap_or_else(|_| "0".into());
+    let out = temp_dir(&format!("soak-{device}"));
+    let (o, report) = run_soak(
+        "config/plate_cut.ron",
+        &seconds,
+        device,
+        &out,
+        &["--markdown"],
+    );
     println!("{}", text(&o.stdout));
     assert!(o.status.success(), "{}\n{report}", text(&o.stderr));
     let r: serde_json::Value = serde_json::from_str(&report).expect("soak.json");
@@ -87,18 +107,7 @@ fn short_scene(dir: &std::path::Path, scene: &str, duration: &str) -> std::path:
 /// Soak `scene` three cuts on the CPU; soak.json's method, verdict and cycles.
 fn soak_short(scene: &std::path::Path, method: &str) -> Vec<serde_json::Value> {
     let out = scene.with_extension("out");
-    let o = incise(&[
-        "soak",
-        scene.to_str().unwrap(),
-        "--seconds",
-        "0",
-        "--device",
-        "cpu",
-        "--out",
-        out.to_str().unwrap(),
-        "--markdown",
-    ]);
-    let report = std::fs::read_to_string(out.join("soak.json")).unwrap_or_default();
+    let (o, report) = run_soak(scene.to_str().unwrap(), "0", "cpu", &out, &["--markdown"]);
     assert!(o.status.success(), "{}\n{report}", text(&o.stderr));
     let r: serde_json::Value = serde_json::from_str(&report).expect("soak.json");
     assert_eq!(
@@ -148,17 +157,7 @@ fn the_budgeted_nakao_chest_soaks_bit_for_bit_replaying_its_free_nodes() {
     let dir = temp_dir("soak-chest");
     let scene = short_scene(&dir, "chest_incision_nakao.ron", "1.0");
     let out = scene.with_extension("out");
-    let o = incise(&[
-        "soak",
-        scene.to_str().unwrap(),
-        "--seconds",
-        "0",
-        "--device",
-        "cpu",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let report = std::fs::read_to_string(out.join("soak.json")).unwrap_or_default();
+    let (o, report) = run_soak(scene.to_str().unwrap(), "0", "cpu", &out, &[]);
     let r: serde_json::Value = serde_json::from_str(&report).expect("soak.json");
     assert_eq!(r["method"], "nakao", "{}", text(&o.stderr));
     // 0.3 s of 10 ms frames, every one localised around the blade.
