@@ -228,6 +228,51 @@ fn an_exercise_draws_its_plan_on_the_tissue() {
     );
 }
 
+/// Pixels of the scalpel in the 3D view: light neutral grey (a heat map is coloured, the
+/// background dark).
+fn steel_pixels(img: &RgbaImage) -> usize {
+    (0..img.height)
+        .flat_map(|y| (300..img.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.get(x, y).map(i32::from);
+            p[0] > 180 && (p[0] - p[1]).abs() < 15 && (p[1] - p[2]).abs() < 15
+        })
+        .count()
+}
+
+/// The Nakao plate's scripted cut (from 0.2 s, 10 ms frames) shows the blade that makes
+/// it, as the XPBD preview shows its scripted scalpel: half-way through the stroke the
+/// scalpel is drawn at the wound's front; the layered organ's indenter is no scalpel.
+#[test]
+fn the_nakao_preview_draws_the_scripted_blade() {
+    let args = [
+        "config/plate_cut_nakao.ron",
+        "--frames",
+        "50",
+        "--size",
+        "900x600",
+    ];
+    let Some(img) = preview_screenshot("xvfb-nakao-script", &args) else {
+        return;
+    };
+    let steel = steel_pixels(&img);
+    eprintln!("{steel} steel pixels");
+    assert!(steel > 500, "no scripted blade drawn: {steel} steel pixels");
+    let args = [
+        "config/organ_layers.ron",
+        "--frames",
+        "30",
+        "--size",
+        "900x600",
+    ];
+    let img = preview_screenshot("xvfb-rheology-script", &args).unwrap();
+    let steel = steel_pixels(&img);
+    assert!(
+        steel < 50,
+        "a scalpel drawn on the indented organ: {steel} steel pixels"
+    );
+}
+
 /// A Nakao exercise opens in the method window with its plan drawn on the plate (the
 /// panel offers its attempts): the same violet line as an XPBD exercise's.
 #[test]
@@ -244,15 +289,8 @@ fn a_nakao_exercise_draws_its_plan_in_the_method_window() {
         (60..5000).contains(&violet),
         "the plan line should be on the plate: {violet} violet pixels"
     );
-    // The mouse's scalpel, drawn where it waits above the plate: light neutral grey (the
-    // plate's heat map is orange, the background dark).
-    let steel = (0..img.height)
-        .flat_map(|y| (300..img.width).map(move |x| (x, y)))
-        .filter(|&(x, y)| {
-            let p = img.get(x, y).map(i32::from);
-            p[0] > 180 && (p[0] - p[1]).abs() < 15 && (p[1] - p[2]).abs() < 15
-        })
-        .count();
+    // The mouse's scalpel, drawn where it waits above the plate.
+    let steel = steel_pixels(&img);
     assert!(steel > 500, "no scalpel drawn: {steel} steel pixels");
     // The blade is the mouse's from the start: the scene's scripted cut (from 0.2 s) does
     // not open the plate before an attempt.

@@ -79,7 +79,7 @@ fn render_view_frame(
             .with_context(|| format!("{}: frame {f}", scene_path.display()))?;
     }
     create_parent(out)?;
-    pictures.save(body.tet_view(), out)
+    pictures.save(body.tet_view(), body.scalpel_pose(), out)
 }
 
 /// Make the folder `path` is to be written in.

@@ -5,10 +5,13 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use incise_sim::contact::ToolPose;
+use incise_xr::frame::ToolState;
 use incise_xr::{OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View};
 
 use super::screenshots::{ImageSize, default_camera};
 use super::tet_drawing::TetDrawing;
+use super::tool_view::pose_matrix;
 use crate::sim_body::TetView;
 
 /// An offscreen renderer of a body's tet views, rebuilt when a cut changes the tets.
@@ -62,6 +65,11 @@ impl ViewPictures {
 
     /// Draw `view` now.
     pub fn image(&mut self, view: TetView) -> Result<RgbaImage> {
+        self.image_with_tool(view, None)
+    }
+
+    /// Draw `view` now with the scalpel at `tool` (`None`: no scalpel).
+    pub fn image_with_tool(&mut self, view: TetView, tool: Option<ToolPose>) -> Result<RgbaImage> {
         self.aim(view)?;
         let (Some(d), Some(off), Some(camera)) = (&self.drawing, &mut self.offscreen, &self.camera)
         else {
@@ -70,14 +78,18 @@ impl ViewPictures {
         let settings = RenderSettings {
             overlays: self.overlays,
             stress_max: d.scale,
+            tool: ToolState {
+                transform: tool.as_ref().map(pose_matrix),
+                spheres: Vec::new(),
+            },
             ..RenderSettings::default()
         };
         Ok(off.render_image(&d.state(), &settings, camera)?)
     }
 
-    /// Draw `view` now and write the PNG to `path`.
-    pub fn save(&mut self, view: TetView, path: &Path) -> Result<()> {
-        self.image(view)?
+    /// Draw `view` (with the scalpel at `tool`) now and write the PNG to `path`.
+    pub fn save(&mut self, view: TetView, tool: Option<ToolPose>, path: &Path) -> Result<()> {
+        self.image_with_tool(view, tool)?
             .save_png(path)
             .with_context(|| format!("writing screenshot {}", path.display()))
     }

@@ -108,12 +108,14 @@ impl WindowContent for Live {
                 ..Overlays::default()
             },
             stress_max: self.body.drawing.scale,
-            // The mouse's scalpel, once it holds the tool.
+            // The mouse's scalpel once it holds the tool; before, the scene's scripted
+            // blade (a Nakao stroke; an indenter is no scalpel).
             tool: ToolState {
-                transform: self.hand.then(|| {
-                    let p = self.scalpel.pose();
-                    Mat4::from_rotation_translation(p.rotation, p.position)
-                }),
+                transform: match self.hand {
+                    true => Some(self.scalpel.pose()),
+                    false => self.body.sim.body.scalpel_pose(),
+                }
+                .map(|p| Mat4::from_rotation_translation(p.rotation, p.position)),
                 spheres: vec![],
             },
             lines: self

@@ -133,6 +133,13 @@ pub trait SimBody {
     /// Where the tool is at the end of the last frame (`None`: no tool).
     fn tool_pose(&self) -> Option<ToolPose>;
 
+    /// Where a scalpel is drawn for the body's tool at the end of the last frame: the
+    /// pose its hand, stroke file or script gave the blade, turned as a hand holds a
+    /// scalpel (`None`: no blade, or the method's tool is no scalpel, e.g. an indenter).
+    fn scalpel_pose(&self) -> Option<ToolPose> {
+        None
+    }
+
     /// Force of the tissue on the tool in the last frame, N (`None`: no tool).
     fn tool_force(&self) -> Option<Vec3>;
 
@@ -210,7 +217,7 @@ pub trait SimBody {
     /// Draw the body now with `shots` (from [`SimBody::screenshots`]) into the PNG `path`.
     fn screenshot(&self, shots: &mut RunPictures, path: &Path) -> anyhow::Result<()> {
         match shots {
-            RunPictures::Views(v) => v.save(self.tet_view(), path),
+            RunPictures::Views(v) => v.save(self.tet_view(), self.scalpel_pose(), path),
             RunPictures::Solver(_) => anyhow::bail!(
                 "XPBD screenshots cannot draw a {} body",
                 self.method().name()

@@ -52,6 +52,9 @@ pub struct NakaoBody {
     blade: Blade,
     /// Where the blade edge was at the end of the last frame.
     pose: Option<BladePose>,
+    /// Where the scalpel showing the blade is drawn (the hand's pose, or the script's
+    /// blade turned to lead along its travel).
+    drawn: Option<ToolPose>,
     local: Option<LocalLoop>,
     localisation: Localisation,
     samples: Vec<LoopSample>,
@@ -90,6 +93,7 @@ impl NakaoBody {
             cutting: false,
             blade: Blade::of_stroke(ms.stroke.clone()),
             pose: None,
+            drawn: None,
             local: local_loop(ms.localisation),
             localisation: ms.localisation,
             samples: Vec::new(),
@@ -139,6 +143,7 @@ impl NakaoBody {
             return (0.0, false);
         };
         self.pose = Some(pose);
+        self.drawn = Some(self.blade.drawn(tool, pose));
         self.touched = engaged && touches(&self.model, pose, self.reach);
         if engaged && !self.cutting {
             self.cutter.begin(&self.model, begin);
@@ -294,6 +299,10 @@ impl SimBody for NakaoBody {
 
     fn tool_pose(&self) -> Option<ToolPose> {
         super::nakao_blade::tool_pose(self.pose)
+    }
+
+    fn scalpel_pose(&self) -> Option<ToolPose> {
+        self.drawn
     }
 
     fn tool_force(&self) -> Option<Vec3> {

@@ -36,6 +36,25 @@ impl Blade {
         self.edge
     }
 
+    /// The scalpel that shows blade `pose` as `tool` put it there: a hand's pose as the
+    /// hand holds it; the script's blade at its tip, turned about the vertical so that
+    /// the tool frame's +x points along the stroke's travel, as the preview's mouse turns
+    /// the blade toward its motion (`ScalpelInput::advance`).
+    pub fn drawn(&self, tool: &ToolInput, pose: BladePose) -> ToolPose {
+        if let ToolInput::Hand { pose, .. } = tool {
+            return *pose;
+        }
+        let travel = self.stroke.as_ref().map_or(glam::Vec3::ZERO, |s| s.travel);
+        let yaw = match travel.truncate() {
+            t if t.length() > 0.0 => t.y.atan2(t.x),
+            _ => 0.0,
+        };
+        ToolPose {
+            position: pose.tip.as_vec3(),
+            rotation: Quat::from_rotation_z(yaw),
+        }
+    }
+
     /// Where `tool` puts the blade at simulated time `t`, whether it cuts, and where a cut
     /// that starts now begins (`previous`: the blade's last pose); `None`: no blade.
     pub fn at(

@@ -193,6 +193,10 @@ impl SimBody for XpbdBody {
         self.pose
     }
 
+    fn scalpel_pose(&self) -> Option<ToolPose> {
+        self.pose
+    }
+
     fn tool_force(&self) -> Option<Vec3> {
         self.tool.as_ref()?;
         Some(self.body.solver().tool_force())
@@ -320,7 +324,7 @@ impl SimBody for XpbdBody {
     fn screenshot(&self, shots: &mut RunPictures, path: &Path) -> Result<()> {
         match shots {
             RunPictures::Solver(s) => s.save(&self.body, path),
-            RunPictures::Views(v) => v.save(self.tet_view(), path),
+            RunPictures::Views(v) => v.save(self.tet_view(), self.scalpel_pose(), path),
         }
     }
 }
