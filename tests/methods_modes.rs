@@ -585,3 +585,43 @@ fn a_starts_a_nakao_headset_session_over() {
         "{frames} frames in the fresh body's report"
     );
 }
+
+/// The Nakao plate's scripted cut in the headset, nobody holding the trigger: both eyes
+/// show the blade that the scene's script moves, as the preview does: with the body
+/// stepped in the frame (display frame 36, 0.5 s in: half-way along the stroke) and on its
+/// own thread (a real-time session; frame 12, once the thread has stepped the body).
+#[test]
+fn a_nakao_headset_session_draws_the_scripted_blade() {
+    let dir = temp_dir("mh-nakao-script-blade");
+    for (mode, frame, realtime) in [("in-frame", 36, ""), ("thread", 12, "realtime: true,")] {
+        let path = dir.join(format!("{mode}.ron"));
+        let script = format!(
+            "(display_hz: 72.0, eye_size: (400, 400), duration: 1.0, render_every: {frame},
+              screenshots: [{frame}], pacing: Nominal, {realtime}
+              head: [(t: 0.0, position: (0.0, 1.25, -0.05),
+                      orientation: (-0.34202, 0.0, 0.0, 0.93969))])"
+        );
+        std::fs::write(&path, script).unwrap();
+        let out = dir.join(mode);
+        let o = run_xr("config/plate_cut_nakao.ron", &path, &out, &["--sim", mode]);
+        if no_adapter(&o) {
+            return;
+        }
+        assert!(o.status.success(), "--sim {mode}: {}", text(&o.stderr));
+        for eye in ["left", "right"] {
+            let png = out.join(format!("eye_{eye}_{frame:05}.png"));
+            let img = incise_xr::RgbaImage::load_png(&png)
+                .unwrap_or_else(|e| panic!("--sim {mode}: {e}: {}", text(&o.stdout)));
+            // Light neutral grey: the plate's heat map is coloured, the room dark.
+            let steel = common::pixels::count(&img, |p| {
+                let p = p.map(i32::from);
+                p[0] > 180 && (p[0] - p[1]).abs() < 15 && (p[1] - p[2]).abs() < 15
+            });
+            eprintln!("--sim {mode}, {eye} eye: {steel} steel pixels");
+            assert!(
+                steel > 20,
+                "--sim {mode}, {eye} eye: no blade ({steel} pixels)"
+            );
+        }
+    }
+}

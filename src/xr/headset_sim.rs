@@ -22,7 +22,7 @@ pub struct Picture<'a> {
     /// Full scale of the heat map (the method's own quantity).
     pub heat_max: f32,
     /// The scalpel, where it is drawn (`None`: not tracked, or the scene's script holds
-    /// the tool).
+    /// a tool that is not drawn: XPBD's, or rheology's indenter).
     pub tool: Option<ToolPose>,
     /// Lines on the tissue (an exercise's plan).
     pub lines: Vec<SurfaceLine>,

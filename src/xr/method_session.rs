@@ -59,7 +59,8 @@ struct Session {
     dev: (RenderDevice, wgpu::TextureFormat),
     /// Whether the controller has taken the tool from the scene's script.
     hand: bool,
-    /// The blade drawn: the controller's, while it holds the tool and is tracked.
+    /// The blade drawn: the controller's, while it holds the tool and is tracked; the
+    /// scene's scripted blade while the script holds it.
     drawn_tool: Option<ToolPose>,
     /// The display time of the first frame, s (simulated time 0).
     start: Option<f64>,
@@ -408,10 +409,6 @@ impl HeadsetSim for Session {
     /// paused).
     fn advance(&mut self, frame: &HeadsetFrame, cmd: &ToolCommand) -> Result<Advanced> {
         let tool = self.tool(cmd);
-        self.drawn_tool = match tool {
-            ToolInput::Hand { pose, .. } if cmd.pose.is_some() => Some(pose),
-            _ => None,
-        };
         let until = self.until(frame, cmd.paused);
         let stamp = (cmd.frame, frame.display_time);
         let tracked = cmd.pose.is_some();
@@ -423,6 +420,13 @@ impl HeadsetSim for Session {
                 None => Ok(()),
             })?;
         self.given_up += step.given_up;
+        // The controller's blade where it holds the tool; the scene's scripted blade
+        // (where the method's tool is a scalpel) while the script holds it.
+        self.drawn_tool = match tool {
+            ToolInput::Hand { pose, .. } if cmd.pose.is_some() => Some(pose),
+            ToolInput::Hand { .. } => None,
+            ToolInput::Script => step.scalpel,
+        };
         if let Some(view) = step.view {
             self.redraw(view)?;
         }

@@ -6,6 +6,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
+use incise_sim::contact::ToolPose;
 
 use super::method_thread::{MethodCommand, MethodThread};
 use super::sim_mode::SimMode;
@@ -46,6 +47,8 @@ pub struct Step {
     pub view: Option<TetView>,
     /// Simulated time given up by a body stepped in the frame slower than real time, s.
     pub given_up: f64,
+    /// Where the body shown draws its scalpel ([`crate::sim_body::SimBody::scalpel_pose`]).
+    pub scalpel: Option<ToolPose>,
 }
 
 impl Stepper {
@@ -125,6 +128,7 @@ impl Stepper {
                     },
                     view: (stepped > 0).then(|| body.body.tet_view()),
                     given_up: owed.max(0.0),
+                    scalpel: body.body.scalpel_pose(),
                 })
             }
             Stepper::Thread {
@@ -146,6 +150,7 @@ impl Stepper {
                     },
                     view: (fresh > 0).then(|| s.view.clone()),
                     given_up: 0.0,
+                    scalpel: s.scalpel,
                 })
             }
         }

@@ -13,6 +13,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
+use incise_sim::contact::ToolPose;
 
 use super::latest::Latest;
 use super::sim_state::CommandStamp;
@@ -39,6 +40,8 @@ pub struct MethodState {
     pub view: TetView,
     /// Magnitude of the tissue's force on the tool, N.
     pub force: f32,
+    /// Where the body draws its scalpel.
+    pub scalpel: Option<ToolPose>,
     /// Frames stepped so far.
     pub frames: usize,
     /// Wall time of the frame's step, ms (0 before the first).
@@ -178,6 +181,7 @@ fn publish(sim: &RecordedBody, link: &Link, step_ms: f64, command: Option<Comman
     link.states.put(MethodState {
         view: sim.body.tet_view(),
         force: sim.body.tool_force().map_or(0.0, |f| f.length()),
+        scalpel: sim.body.scalpel_pose(),
         frames: sim.frames(),
         step_ms,
         command,
