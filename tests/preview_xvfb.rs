@@ -54,12 +54,7 @@ fn preview_screenshot_on(name: &str, args: &[&str], device: &str) -> Option<Rgba
         .env("XDG_RUNTIME_DIR", &dir)
         .output()
         .expect("xvfb-run runs");
-    let err = String::from_utf8_lossy(&o.stderr);
-    if !o.status.success() && err.contains("no GPU adapter") && !required() {
-        eprintln!("skipping: {err}");
-        return None;
-    }
-    assert!(o.status.success(), "preview failed: {err}");
+    passed_or_skipped(o)?;
     Some(RgbaImage::load_png(&shot).unwrap())
 }
 
@@ -95,6 +90,18 @@ fn preview_opens_a_window_renders_and_exits_after_n_frames() {
         reddish > 300,
         "the beam's tissue should be on screen ({reddish} pixels)"
     );
+}
+
+/// A preview run's output when it succeeded; `None` (said why) when it found no GPU
+/// adapter and the GPU is not required; a failure otherwise.
+fn passed_or_skipped(o: std::process::Output) -> Option<std::process::Output> {
+    let err = String::from_utf8_lossy(&o.stderr);
+    if !o.status.success() && err.contains("no GPU adapter") && !required() {
+        eprintln!("skipping: {err}");
+        return None;
+    }
+    assert!(o.status.success(), "preview failed: {err}");
+    Some(o)
 }
 
 /// The scalpel scene without its own tool and stroke: only the mouse can cut it.
@@ -135,13 +142,7 @@ fn xdotool_session(script: &str, cwd: &Path, dir: &Path) -> Option<std::process:
         .env("XDG_RUNTIME_DIR", dir)
         .output()
         .expect("xvfb-run runs");
-    let err = String::from_utf8_lossy(&o.stderr);
-    if !o.status.success() && err.contains("no GPU adapter") && !required() {
-        eprintln!("skipping: {err}");
-        return None;
-    }
-    assert!(o.status.success(), "preview failed: {err}");
-    Some(o)
+    passed_or_skipped(o)
 }
 
 #[test]
