@@ -170,7 +170,7 @@ fn a_method_window_attempt_on_a_nakao_exercise_scores_as_incise_exercise_does() 
             engaged: true,
         })
         .unwrap();
-        mode.after_step(&body, pose).unwrap();
+        mode.after_step(&body, pose, true).unwrap();
     }
     assert!(mode.live.touched(), "the blade never touched the plate");
     assert_eq!(mode.live.running(), Some(frames as usize));

@@ -722,3 +722,82 @@ fn a_nakao_exercise_in_the_headset_is_scored_on_its_cut_surface() {
         card_pixels(&after)
     );
 }
+
+/// A Nakao attempt in the headset with the trigger let go for a second mid-stroke (1.2 to
+/// 2.2 s, the blade still in the plate): the live cut pauses there, the recorded stroke
+/// is lifted over that second, and its replay (`incise exercise --stroke`) cuts the same
+/// surface, face for face, instead of cutting all along.
+#[test]
+fn a_nakao_attempt_with_the_trigger_let_go_replays_its_cut() {
+    let script = stroke_script(
+        "plate_line_nakao_reference.ron",
+        4.0,
+        "buttons: [(3.7, A)], screenshots: []",
+    )
+    .replace(
+        "trigger: [(0.0, 1.0)]",
+        "trigger: [(0.0, 1.0), (1.2, 0.0), (2.2, 1.0)]",
+    );
+    let exercise = "config/exercises/plate_line_nakao.ron";
+    let (out, r, o) = run_exercise_on(exercise, "xr-exercise-nakao-lifted", &script, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let attempts = r["attempts"].as_array().unwrap();
+    assert_eq!(attempts.len(), 1, "{r}");
+    let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
+    let stroke = incise_scalpel::load_stroke(&dir.join("stroke.ron")).unwrap();
+    let lifted = stroke.lifted().to_vec();
+    assert_eq!(lifted.len(), 1, "{lifted:?}");
+    // The second the trigger was up, on the attempt's clock.
+    let (from, to) = lifted[0];
+    assert!((0.9..1.2).contains(&(to - from)), "{lifted:?}");
+    let (live, replayed) = assert_replay_scores_alike(exercise, &dir, &out);
+    let faces = |v: &Value| v["metrics"]["cut_faces"].as_u64().unwrap();
+    eprintln!(
+        "cut faces: live {}, replay {}",
+        faces(&live),
+        faces(&replayed)
+    );
+    assert!(faces(&live) > 10, "{}", live["metrics"]);
+    assert_eq!(
+        faces(&live),
+        faces(&replayed),
+        "live {live}\nreplay {replayed}"
+    );
+    assert_eq!(
+        live["metrics"]["cut_area"], replayed["metrics"]["cut_area"],
+        "live {live}\nreplay {replayed}"
+    );
+}
+
+/// The same for an XPBD attempt (slab_depth): the trigger let go 0.5 to 0.9 s into the
+/// session, the blade in the slab, dulls it live (it pushes, cuts nothing); the recorded
+/// stroke is lifted there and its replay dulls the blade there too, releasing the live
+/// attempt's tets.
+#[test]
+fn an_xpbd_attempt_with_the_trigger_let_go_replays_its_cut() {
+    let script = exercise_script(2.2, "buttons: [(1.8, A)], screenshots: []").replace(
+        "trigger: [(0.0, 1.0)]",
+        "trigger: [(0.0, 1.0), (0.5, 0.0), (0.9, 1.0)]",
+    );
+    let exercise = "config/exercises/slab_depth.ron";
+    let (out, r, o) = run_exercise_on(exercise, "xr-exercise-xpbd-lifted", &script, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let attempts = r["attempts"].as_array().unwrap();
+    assert_eq!(attempts.len(), 1, "{r}");
+    let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
+    let stroke = incise_scalpel::load_stroke(&dir.join("stroke.ron")).unwrap();
+    assert_eq!(stroke.lifted().len(), 1, "{:?}", stroke.lifted());
+    let (live, replayed) = assert_replay_scores_alike(exercise, &dir, &out);
+    let released = |v: &Value| v["metrics"]["released_tets"].as_u64().unwrap();
+    eprintln!(
+        "released tets: live {}, replay {}",
+        released(&live),
+        released(&replayed)
+    );
+    assert!(released(&live) > 10, "{}", live["metrics"]);
+    assert_eq!(
+        released(&live),
+        released(&replayed),
+        "live {live}\nreplay {replayed}"
+    );
+}

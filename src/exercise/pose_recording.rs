@@ -17,10 +17,11 @@ pub struct PoseRecording {
 }
 
 impl PoseRecording {
-    /// Record the blade at `pose` at attempt time `t`, s (nothing while not recording).
-    pub fn push(&mut self, t: f64, pose: ToolPose) -> Result<()> {
+    /// Record the blade at `pose` at attempt time `t`, s, and whether the hand engaged it
+    /// (trigger or button down; nothing while not recording).
+    pub fn push(&mut self, t: f64, pose: ToolPose, engaged: bool) -> Result<()> {
         if let Some(r) = &mut self.recorder {
-            r.push(t, pose)?;
+            r.push_engaged(t, pose, engaged)?;
         }
         Ok(())
     }

@@ -39,14 +39,15 @@ impl MethodExercise {
         self.live.start(&mut self.stroke, body, pictures)
     }
 
-    /// After `body` stepped a frame with the blade at `pose`: keep the frame's tool figures
-    /// and the pose, at the frame's end (nothing without an attempt).
-    pub fn after_step(&mut self, body: &RecordedBody, pose: ToolPose) -> Result<()> {
+    /// After `body` stepped a frame with the blade at `pose` (`engaged`: the button down):
+    /// keep the frame's tool figures and the pose, at the frame's end (nothing without an
+    /// attempt).
+    pub fn after_step(&mut self, body: &RecordedBody, pose: ToolPose, engaged: bool) -> Result<()> {
         let Some(frame) = body.last_frame().filter(|_| self.live.running().is_some()) else {
             return Ok(());
         };
         self.live.after_step(ToolFrame::of(frame));
-        self.stroke.push(body.body.time(), pose)
+        self.stroke.push(body.body.time(), pose, engaged)
     }
 
     /// Finish the attempt on `body`: scored, saved under `out_root`, appended to `history`.

@@ -236,10 +236,10 @@ impl Live {
     /// After a frame stepped with `tool`: the attempt under way keeps its figures and the
     /// blade's pose.
     fn keep_for_attempt(&mut self, tool: &ToolInput) {
-        let (Some(e), ToolInput::Hand { pose, .. }) = (&mut self.exercise, tool) else {
+        let (Some(e), ToolInput::Hand { pose, engaged }) = (&mut self.exercise, tool) else {
             return;
         };
-        if let Err(err) = e.after_step(&self.body.sim, *pose) {
+        if let Err(err) = e.after_step(&self.body.sim, *pose, *engaged) {
             self.message = format!("{err:#}");
         }
     }

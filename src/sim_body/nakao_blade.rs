@@ -90,11 +90,12 @@ pub fn tool_point(pose: BladePose) -> DVec3 {
 }
 
 /// What a stroke file does to the blade at simulated time `t`, as a hand would: the tool
-/// at the stroke's pose, cutting from the stroke's first key to its last.
+/// at the stroke's pose, cutting from the stroke's first key to its last except where
+/// the recorded hand held it lifted (trigger or button up).
 pub fn stroke_hand(stroke: &Stroke, t: f64) -> ToolInput {
     ToolInput::Hand {
         pose: stroke.pose_at(t),
-        engaged: t >= stroke.start_time() && t <= stroke.end_time(),
+        engaged: stroke.engaged_at(t),
     }
 }
 

@@ -41,6 +41,9 @@ pub struct XpbdBody {
     pub tool: Option<SceneTool>,
     /// Where the tool was put for the last frame.
     pose: Option<ToolPose>,
+    /// Whether the tool is held without cutting (a hand's trigger up, a recorded stroke's
+    /// lifted span): it pushes, dulled, as the headset's does.
+    lifted: bool,
 }
 
 /// Open `scene` (from `path`) as an XPBD body with the run's report skeleton.
@@ -95,6 +98,7 @@ pub fn open(
             skin,
             tool,
             pose,
+            lifted: false,
         },
         report,
     ))
@@ -162,6 +166,42 @@ impl XpbdBody {
             }
         }
     }
+
+    /// Whether `tool` holds the scalpel without cutting in the next frame: a hand's
+    /// trigger up, or the stroke's lifted span (a recorded hand's).
+    fn lifted_by(&self, tool: &ToolInput) -> bool {
+        match tool {
+            ToolInput::Hand { engaged, .. } => !engaged,
+            ToolInput::Script => self
+                .tool
+                .as_ref()
+                .and_then(|t| t.stroke.as_ref())
+                .is_some_and(|s| {
+                    let frame = self.body.solver().frame();
+                    s.lifted_at((frame + 1) as f64 * self.frame_dt())
+                }),
+        }
+    }
+
+    /// Put the scalpel at `pose` for the next frame, dulled while `lifted` (the tool is
+    /// set anew, as the headset's `XrBody::drive_tool` does, when that changes).
+    fn place_tool(&mut self, pose: ToolPose, lifted: bool) -> Result<(), SolverError> {
+        self.pose = Some(pose);
+        match &self.tool {
+            Some(t) if lifted != self.lifted => {
+                self.lifted = lifted;
+                let contact = match lifted {
+                    true => t.contact.dulled(),
+                    false => t.contact.clone(),
+                };
+                self.body.set_tool(contact, pose)
+            }
+            _ => {
+                self.body.move_tool(pose);
+                Ok(())
+            }
+        }
+    }
 }
 
 impl SimBody for XpbdBody {
@@ -179,8 +219,8 @@ impl SimBody for XpbdBody {
 
     fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError> {
         if let Some(pose) = self.next_pose(tool) {
-            self.body.move_tool(pose);
-            self.pose = Some(pose);
+            self.place_tool(pose, self.lifted_by(tool))
+                .map_err(|e| StepError::Failed(e.to_string()))?;
         }
         match self.body.step_frame() {
             Ok(stats) => Ok(FrameData::Xpbd(stats)),
@@ -266,12 +306,14 @@ impl SimBody for XpbdBody {
             skin,
             tool,
             pose,
+            lifted,
         } = *self;
         Box::new(XpbdBody {
             body: body.into_cpu(),
             skin,
             tool,
             pose,
+            lifted,
         })
     }
 

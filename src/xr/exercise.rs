@@ -82,13 +82,19 @@ impl<B: AttemptBody> XrExercise<B> {
     }
 
     /// After a simulated frame: keep its tool figures and the scalpel's pose (when the
-    /// controller is tracked).
-    pub fn after_step(&mut self, frame: ToolFrame, pose: Option<ToolPose>, dt: f64) -> Result<()> {
+    /// controller is tracked) with whether the trigger engaged it.
+    pub fn after_step(
+        &mut self,
+        frame: ToolFrame,
+        pose: Option<ToolPose>,
+        engaged: bool,
+        dt: f64,
+    ) -> Result<()> {
         self.live.after_step(frame);
         // The attempt's clock: its frames so far (none kept without an attempt).
         let frames = self.live.running().unwrap_or(0);
         if let Some(p) = pose {
-            self.stroke.push(frames as f64 * dt, p)?;
+            self.stroke.push(frames as f64 * dt, p, engaged)?;
         }
         Ok(())
     }

@@ -90,11 +90,15 @@ impl<'s, 'x> InFrameSim<'s, 'x> {
                 break;
             }
             match self.stepper.step(self.xr, cmd)? {
-                Stepped::Done { stats, pose } => {
+                Stepped::Done {
+                    stats,
+                    pose,
+                    engaged,
+                } => {
                     done.sim_frames += 1;
                     done.tool_force = done.tool_force.max(stats.tool_force.length());
                     if let Some(ex) = exercise.as_deref_mut() {
-                        ex.after_step(ToolFrame::of_xpbd(&stats), pose, dt)?;
+                        ex.after_step(ToolFrame::of_xpbd(&stats), pose, engaged, dt)?;
                     }
                 }
                 Stepped::Failed(e) => {

@@ -250,12 +250,12 @@ impl Session {
         tool: &ToolInput,
         tracked: bool,
     ) -> Result<()> {
-        let (Some(frame), ToolInput::Hand { pose, .. }) = (b.last_frame(), tool) else {
+        let (Some(frame), ToolInput::Hand { pose, engaged }) = (b.last_frame(), tool) else {
             return Ok(());
         };
         let pose = tracked.then_some(*pose);
         ex.live
-            .after_step(ToolFrame::of(frame), pose, b.body.frame_dt())
+            .after_step(ToolFrame::of(frame), pose, *engaged, b.body.frame_dt())
     }
 
     /// Close the body after the display loop (its `report.json` written unless the

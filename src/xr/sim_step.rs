@@ -21,6 +21,9 @@ pub enum Stepped {
         stats: FrameStats,
         /// The scalpel's pose it was stepped with (when tracked).
         pose: Option<ToolPose>,
+        /// Whether the scalpel cut (the trigger held; a played stroke outside its lifted
+        /// spans).
+        engaged: bool,
     },
     /// The solver gave up (the frame was rolled back); the caller resets the scene.
     Failed(anyhow::Error),
@@ -78,7 +81,7 @@ impl<'a> SimStepper<'a> {
     /// Place the blade where a played stroke starts (as `incise run --stroke` does).
     pub fn start(&self, xr: &mut XrBody) -> Result<()> {
         match self.stroke {
-            Some(s) => xr.drive_tool(Some(s.pose_at(0.0)), true),
+            Some(s) => xr.drive_tool(Some(s.pose_at(0.0)), !s.lifted_at(0.0)),
             None => Ok(()),
         }
     }
@@ -89,11 +92,15 @@ impl<'a> SimStepper<'a> {
     }
 
     /// Step one frame of `xr` with `cmd` (a played stroke: its pose at the end of the
-    /// frame, engaged). Errors other than a solver failure end the session.
+    /// frame, engaged but in its lifted spans). Errors other than a solver failure end the
+    /// session.
     pub fn step(&mut self, xr: &mut XrBody, cmd: &ToolCommand) -> Result<Stepped> {
         let started = Instant::now();
         let (pose, engaged) = match self.stroke {
-            Some(s) => (Some(s.pose_at(self.sim_time + self.sim_dt)), true),
+            Some(s) => {
+                let t = self.sim_time + self.sim_dt;
+                (Some(s.pose_at(t)), !s.lifted_at(t))
+            }
             None => (cmd.pose, cmd.engaged),
         };
         xr.drive_tool(pose, engaged)?;
@@ -120,9 +127,13 @@ impl<'a> SimStepper<'a> {
         self.last_command = Some((cmd.frame, cmd.display_time));
         self.last_ms = started.elapsed().as_secs_f64() * 1e3;
         if let (Some(r), Some(p)) = (&mut self.recorder, pose) {
-            r.push(self.sim_time, p)?;
+            r.push_engaged(self.sim_time, p, engaged)?;
         }
-        Ok(Stepped::Done { stats, pose })
+        Ok(Stepped::Done {
+            stats,
+            pose,
+            engaged,
+        })
     }
 
     /// The recorded path as a stroke (none without two poses: a stroke needs two).

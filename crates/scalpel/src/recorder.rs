@@ -9,6 +9,8 @@ use crate::stroke::{PoseKey, Stroke};
 #[derive(Debug, Clone, Default)]
 pub struct StrokeRecorder {
     keys: Vec<PoseKey>,
+    /// Whether each key's tool was engaged.
+    engaged: Vec<bool>,
 }
 
 impl StrokeRecorder {
@@ -17,10 +19,21 @@ impl StrokeRecorder {
         Self::default()
     }
 
-    /// Record the pose at time `t` (s). Rotations are normalised (tracking drift). A
-    /// sample that is not later than the previous one, or that is not finite, is refused
-    /// and the recording is unchanged.
+    /// Record the pose at time `t` (s), the tool engaged. Rotations are normalised
+    /// (tracking drift). A sample that is not later than the previous one, or that is not
+    /// finite, is refused and the recording is unchanged.
     pub fn push(&mut self, t: f64, pose: ToolPose) -> Result<(), FieldError> {
+        self.push_engaged(t, pose, true)
+    }
+
+    /// [`StrokeRecorder::push`] with whether the hand engaged the tool (trigger or button
+    /// down) at that sample; the finished stroke is lifted where it did not.
+    pub fn push_engaged(
+        &mut self,
+        t: f64,
+        pose: ToolPose,
+        engaged: bool,
+    ) -> Result<(), FieldError> {
         let i = self.keys.len();
         let field = |f: &str| format!("poses[{i}].{f}");
         if !t.is_finite() {
@@ -52,6 +65,7 @@ impl StrokeRecorder {
             position: pose.position,
             rotation: pose.rotation / len,
         });
+        self.engaged.push(engaged);
         Ok(())
     }
 
@@ -71,8 +85,37 @@ impl StrokeRecorder {
         self.keys.is_empty()
     }
 
-    /// The recorded stroke (an error if fewer than 2 samples were recorded).
+    /// The recorded stroke (an error if fewer than 2 samples were recorded), lifted over
+    /// each run of samples taken with the tool not engaged.
     pub fn finish(self) -> Result<Stroke, FieldError> {
-        Stroke::new(self.keys)
+        let lifted = lifted_spans(&self.keys, &self.engaged);
+        Stroke::new(self.keys)?.with_lifted(lifted)
     }
+}
+
+/// The spans covering each run of not-engaged samples: from half-way after the engaged
+/// sample before it (its own time when it is the first) to half-way before the engaged
+/// sample after it (past the last key when there is none), so that a replay asking at a
+/// sample's own time, or a hair off it, finds the sample's state.
+fn lifted_spans(keys: &[PoseKey], engaged: &[bool]) -> Vec<(f64, f64)> {
+    let mut spans = Vec::new();
+    let mut i = 0;
+    while i < keys.len() {
+        if engaged[i] {
+            i += 1;
+            continue;
+        }
+        let first = i;
+        while i < keys.len() && !engaged[i] {
+            i += 1;
+        }
+        let from = match first {
+            0 => keys[0].t,
+            _ => 0.5 * (keys[first - 1].t + keys[first].t),
+        };
+        let last = keys[i - 1].t;
+        let to = keys.get(i).map_or(last + 1.0, |next| 0.5 * (last + next.t));
+        spans.push((from, to));
+    }
+    spans
 }

@@ -1,6 +1,8 @@
 //! A stroke: timed tool poses, read from and written to RON
 //! (`(poses: [(t: 0.0, position: (x, y, z), rotation: (x, y, z, w)), ...])`, metres,
-//! seconds, quaternion in glam's xyzw order), and the tool pose at any time.
+//! seconds, quaternion in glam's xyzw order), the spans in which the hand held the tool
+//! without engaging it (`lifted: [(from, to), ...]`, s; none: engaged throughout), and
+//! the tool pose at any time.
 
 use std::path::Path;
 
@@ -37,6 +39,8 @@ impl PoseKey {
 #[serde(deny_unknown_fields)]
 struct StrokeFile {
     poses: Vec<PoseKey>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    lifted: Vec<(f64, f64)>,
 }
 
 /// A validated stroke: at least two keys, times finite and strictly increasing,
@@ -46,6 +50,8 @@ pub struct Stroke {
     times: Vec<f64>,
     positions: Vec<Vec3>,
     keys: Vec<PoseKey>,
+    /// Spans `[from, to)` in which the tool was held but not engaged, s.
+    lifted: Vec<(f64, f64)>,
 }
 
 /// How far a key's rotation may be from unit length.
@@ -60,7 +66,9 @@ pub fn load_stroke(path: &Path) -> Result<Stroke, FileError> {
 /// Parse and validate stroke RON text; `path` names it in errors.
 pub fn parse_stroke(text: &str, path: &Path) -> Result<Stroke, FileError> {
     let file: StrokeFile = ron_file::parse(text, path)?;
-    Stroke::new(file.poses).map_err(|e| ron_text::value_error(text, path, e))
+    Stroke::new(file.poses)
+        .and_then(|s| s.with_lifted(file.lifted))
+        .map_err(|e| ron_text::value_error(text, path, e))
 }
 
 impl Stroke {
@@ -109,7 +117,43 @@ impl Stroke {
             times: keys.iter().map(|k| k.t).collect(),
             positions: keys.iter().map(|k| k.position).collect(),
             keys,
+            lifted: Vec::new(),
         })
+    }
+
+    /// The stroke with the tool not engaged (trigger or button up) in the spans
+    /// `[from, to)` of `lifted`, s: each finite, `from < to`, in time order without
+    /// overlap (errors name `lifted[i]`).
+    pub fn with_lifted(mut self, lifted: Vec<(f64, f64)>) -> Result<Stroke, FieldError> {
+        for (i, &(from, to)) in lifted.iter().enumerate() {
+            let after_previous = i == 0 || lifted[i - 1].1 <= from;
+            if !(from.is_finite() && to.is_finite() && from < to && after_previous) {
+                return Err(FieldError::new(
+                    format!("lifted[{i}]"),
+                    format!(
+                        "({from}, {to}) must be a finite span from < to, after the previous one"
+                    ),
+                ));
+            }
+        }
+        self.lifted = lifted;
+        Ok(self)
+    }
+
+    /// The spans in which the tool was held but not engaged, s.
+    pub fn lifted(&self) -> &[(f64, f64)] {
+        &self.lifted
+    }
+
+    /// Whether time `t` is in a lifted span (the tool held without engaging it).
+    pub fn lifted_at(&self, t: f64) -> bool {
+        self.lifted.iter().any(|&(from, to)| from <= t && t < to)
+    }
+
+    /// Whether the tool is engaged (cuts, grabs, presses) at time `t`: within the keys'
+    /// times and outside every lifted span.
+    pub fn engaged_at(&self, t: f64) -> bool {
+        t >= self.start_time() && t <= self.end_time() && !self.lifted_at(t)
     }
 
     /// The keys, in time order.
@@ -163,6 +207,7 @@ impl Stroke {
     pub fn to_ron(&self) -> Result<String, ron::Error> {
         let file = StrokeFile {
             poses: self.keys.clone(),
+            lifted: self.lifted.clone(),
         };
         let config = ron::ser::PrettyConfig::new()
             .depth_limit(2)

@@ -221,6 +221,53 @@ fn malformed_stroke_gives_line_and_column() {
     assert!(e.starts_with("s.ron:3:") && e.contains("positon"), "{e}");
 }
 
+/// A recorded hand that let the trigger go between samples: the finished stroke is
+/// lifted there, engaged at each sample exactly as recorded (and a hair either side of
+/// its time), and keeps its lifted spans through a file; a stroke file without them is
+/// engaged from its first key to its last.
+#[test]
+fn a_recorded_stroke_is_lifted_where_the_hand_did_not_engage() {
+    let flags = [false, true, true, false, false, true, false];
+    let mut r = StrokeRecorder::new();
+    for (i, &engaged) in flags.iter().enumerate() {
+        let pose = ToolPose::new(Vec3::X * i as f32 * 0.01, Quat::IDENTITY);
+        r.push_engaged(0.1 * i as f64, pose, engaged).unwrap();
+    }
+    let s = r.finish().unwrap();
+    let check = |s: &Stroke| {
+        for (k, &engaged) in s.keys().iter().zip(&flags) {
+            for t in [k.t, k.t - 1e-9, k.t + 1e-9] {
+                if t >= s.start_time() && t <= s.end_time() {
+                    assert_eq!(s.engaged_at(t), engaged, "at {t} s: {:?}", s.lifted());
+                }
+            }
+        }
+    };
+    check(&s);
+    let dir = scratch("lifted");
+    let path = dir.join("lifted.ron");
+    s.save(&path).unwrap();
+    let loaded = load_stroke(&path).unwrap();
+    assert_eq!(loaded, s);
+    check(&loaded);
+    let plain = good();
+    assert!(plain.lifted().is_empty());
+    assert!(plain.engaged_at(0.0) && plain.engaged_at(1.3) && !plain.engaged_at(1.31));
+    assert!(
+        std::fs::read_to_string(&path)
+            .unwrap()
+            .contains("lifted: [")
+    );
+    // Spans out of order are refused, naming the span and its line.
+    let bad = GOOD.replace(
+        "    ],\n)",
+        "    ],\n    lifted: [(0.5, 0.6), (0.55, 0.7)],\n)",
+    );
+    let (line, field, _, _) = value_error(&bad);
+    assert_eq!((line, field.as_str()), (9, "lifted[1]"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn recorder_refuses_bad_samples_and_finishes() {
     let mut r = StrokeRecorder::new();
