@@ -723,6 +723,33 @@ fn a_nakao_exercise_in_the_headset_is_scored_on_its_cut_surface() {
     );
 }
 
+/// `incise xr --exercise EXERCISE` on `script` with its trigger let go from `up` to
+/// `down` s, then the one attempt's replay: the span the recorded stroke is lifted over
+/// (one, as long as the trigger was up, on the attempt's clock) checked, and the live
+/// and replayed results.
+fn attempt_with_the_trigger_let_go(
+    exercise: &str,
+    name: &str,
+    script: &str,
+    (up, down): (f64, f64),
+) -> (Value, Value) {
+    let script = script.replace(
+        "trigger: [(0.0, 1.0)]",
+        &format!("trigger: [(0.0, 1.0), ({up}, 0.0), ({down}, 1.0)]"),
+    );
+    let (out, r, o) = run_exercise_on(exercise, name, &script, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let attempts = r["attempts"].as_array().unwrap();
+    assert_eq!(attempts.len(), 1, "{r}");
+    let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
+    let stroke = incise_scalpel::load_stroke(&dir.join("stroke.ron")).unwrap();
+    let lifted = stroke.lifted().to_vec();
+    assert_eq!(lifted.len(), 1, "{lifted:?}");
+    let span = lifted[0].1 - lifted[0].0;
+    assert!((span - (down - up)).abs() < 0.1, "{lifted:?}");
+    assert_replay_scores_alike(exercise, &dir, &out)
+}
+
 /// A Nakao attempt in the headset with the trigger let go for a second mid-stroke (1.2 to
 /// 2.2 s, the blade still in the plate): the live cut pauses there, the recorded stroke
 /// is lifted over that second, and its replay (`incise exercise --stroke`) cuts the same
@@ -733,24 +760,13 @@ fn a_nakao_attempt_with_the_trigger_let_go_replays_its_cut() {
         "plate_line_nakao_reference.ron",
         4.0,
         "buttons: [(3.7, A)], screenshots: []",
-    )
-    .replace(
-        "trigger: [(0.0, 1.0)]",
-        "trigger: [(0.0, 1.0), (1.2, 0.0), (2.2, 1.0)]",
     );
-    let exercise = "config/exercises/plate_line_nakao.ron";
-    let (out, r, o) = run_exercise_on(exercise, "xr-exercise-nakao-lifted", &script, &[]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let attempts = r["attempts"].as_array().unwrap();
-    assert_eq!(attempts.len(), 1, "{r}");
-    let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
-    let stroke = incise_scalpel::load_stroke(&dir.join("stroke.ron")).unwrap();
-    let lifted = stroke.lifted().to_vec();
-    assert_eq!(lifted.len(), 1, "{lifted:?}");
-    // The second the trigger was up, on the attempt's clock.
-    let (from, to) = lifted[0];
-    assert!((0.9..1.2).contains(&(to - from)), "{lifted:?}");
-    let (live, replayed) = assert_replay_scores_alike(exercise, &dir, &out);
+    let (live, replayed) = attempt_with_the_trigger_let_go(
+        "config/exercises/plate_line_nakao.ron",
+        "xr-exercise-nakao-lifted",
+        &script,
+        (1.2, 2.2),
+    );
     let faces = |v: &Value| v["metrics"]["cut_faces"].as_u64().unwrap();
     eprintln!(
         "cut faces: live {}, replay {}",
@@ -775,19 +791,12 @@ fn a_nakao_attempt_with_the_trigger_let_go_replays_its_cut() {
 /// attempt's tets.
 #[test]
 fn an_xpbd_attempt_with_the_trigger_let_go_replays_its_cut() {
-    let script = exercise_script(2.2, "buttons: [(1.8, A)], screenshots: []").replace(
-        "trigger: [(0.0, 1.0)]",
-        "trigger: [(0.0, 1.0), (0.5, 0.0), (0.9, 1.0)]",
+    let (live, replayed) = attempt_with_the_trigger_let_go(
+        "config/exercises/slab_depth.ron",
+        "xr-exercise-xpbd-lifted",
+        &exercise_script(2.2, "buttons: [(1.8, A)], screenshots: []"),
+        (0.5, 0.9),
     );
-    let exercise = "config/exercises/slab_depth.ron";
-    let (out, r, o) = run_exercise_on(exercise, "xr-exercise-xpbd-lifted", &script, &[]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let attempts = r["attempts"].as_array().unwrap();
-    assert_eq!(attempts.len(), 1, "{r}");
-    let dir = std::path::PathBuf::from(attempts[0]["dir"].as_str().unwrap());
-    let stroke = incise_scalpel::load_stroke(&dir.join("stroke.ron")).unwrap();
-    assert_eq!(stroke.lifted().len(), 1, "{:?}", stroke.lifted());
-    let (live, replayed) = assert_replay_scores_alike(exercise, &dir, &out);
     let released = |v: &Value| v["metrics"]["released_tets"].as_u64().unwrap();
     eprintln!(
         "released tets: live {}, replay {}",
