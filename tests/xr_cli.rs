@@ -724,9 +724,9 @@ fn a_nakao_exercise_in_the_headset_is_scored_on_its_cut_surface() {
 }
 
 /// `incise xr --exercise EXERCISE` on `script` with its trigger let go from `up` to
-/// `down` s, then the one attempt's replay: the span the recorded stroke is lifted over
-/// (one, as long as the trigger was up, on the attempt's clock) checked, and the live
-/// and replayed results.
+/// `down` s (the script's trigger is linear between keys: a step takes two keys 10 ms
+/// apart), then the one attempt's replay: the span the recorded stroke is lifted over
+/// (one, where the trigger was up) checked, and the live and replayed results.
 fn attempt_with_the_trigger_let_go(
     exercise: &str,
     name: &str,
@@ -735,7 +735,11 @@ fn attempt_with_the_trigger_let_go(
 ) -> (Value, Value) {
     let script = script.replace(
         "trigger: [(0.0, 1.0)]",
-        &format!("trigger: [(0.0, 1.0), ({up}, 0.0), ({down}, 1.0)]"),
+        &format!(
+            "trigger: [(0.0, 1.0), ({}, 1.0), ({up}, 0.0), ({}, 0.0), ({down}, 1.0)]",
+            up - 0.01,
+            down - 0.01
+        ),
     );
     let (out, r, o) = run_exercise_on(exercise, name, &script, &[]);
     assert!(o.status.success(), "{}", text(&o.stderr));
@@ -745,8 +749,12 @@ fn attempt_with_the_trigger_let_go(
     let stroke = incise_scalpel::load_stroke(&dir.join("stroke.ron")).unwrap();
     let lifted = stroke.lifted().to_vec();
     assert_eq!(lifted.len(), 1, "{lifted:?}");
-    let span = lifted[0].1 - lifted[0].0;
-    assert!((span - (down - up)).abs() < 0.1, "{lifted:?}");
+    let (from, to) = lifted[0];
+    eprintln!("trigger up {up}-{down} s, stroke lifted {from}-{to} s");
+    assert!(
+        (from - up).abs() < 0.05 && (to - down).abs() < 0.05,
+        "{lifted:?}"
+    );
     assert_replay_scores_alike(exercise, &dir, &out)
 }
 
