@@ -15,7 +15,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use glam::Mat4;
+
 use incise_xr::{Overlays, RenderSettings, Renderer, ToolState};
 use winit::event::ElementState;
 
@@ -27,6 +27,7 @@ use super::window_app::{WindowContent, WindowShell, run_window, save_frame};
 use super::window_gpu::WindowGpu;
 use crate::pictures::drawn_body::DrawnBody;
 use crate::pictures::screenshots::ImageSize;
+use crate::pictures::tool_view::pose_matrix;
 use crate::sim_body::ToolInput;
 
 /// What `incise preview` asked of a method window.
@@ -115,7 +116,8 @@ impl WindowContent for Live {
                     true => Some(self.scalpel.pose()),
                     false => self.body.sim.body.scalpel_pose(),
                 }
-                .map(|p| Mat4::from_rotation_translation(p.rotation, p.position)),
+                .as_ref()
+                .map(pose_matrix),
                 spheres: vec![],
             },
             lines: self

@@ -155,31 +155,17 @@ fn tool_info(t: &SceneTool) -> ToolInfo {
 }
 
 impl XpbdBody {
-    /// Where `tool` puts the scalpel at the end of the next frame.
-    fn next_pose(&self, tool: &ToolInput) -> Option<ToolPose> {
+    /// Where `tool` puts the scalpel at the end of the next frame, and whether it holds
+    /// it there without cutting: a hand's trigger up, or the stroke's lifted span (a
+    /// recorded hand's).
+    fn next_pose(&self, tool: &ToolInput) -> Option<(ToolPose, bool)> {
         match tool {
-            ToolInput::Hand { pose, .. } => Some(*pose),
+            ToolInput::Hand { pose, engaged } => Some((*pose, !engaged)),
             ToolInput::Script => {
                 let stroke = self.tool.as_ref()?.stroke.as_ref()?;
-                let frame = self.body.solver().frame();
-                Some(stroke.pose_at((frame + 1) as f64 * self.frame_dt()))
+                let t = (self.body.solver().frame() + 1) as f64 * self.frame_dt();
+                Some((stroke.pose_at(t), stroke.lifted_at(t)))
             }
-        }
-    }
-
-    /// Whether `tool` holds the scalpel without cutting in the next frame: a hand's
-    /// trigger up, or the stroke's lifted span (a recorded hand's).
-    fn lifted_by(&self, tool: &ToolInput) -> bool {
-        match tool {
-            ToolInput::Hand { engaged, .. } => !engaged,
-            ToolInput::Script => self
-                .tool
-                .as_ref()
-                .and_then(|t| t.stroke.as_ref())
-                .is_some_and(|s| {
-                    let frame = self.body.solver().frame();
-                    s.lifted_at((frame + 1) as f64 * self.frame_dt())
-                }),
         }
     }
 
@@ -218,8 +204,8 @@ impl SimBody for XpbdBody {
     }
 
     fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError> {
-        if let Some(pose) = self.next_pose(tool) {
-            self.place_tool(pose, self.lifted_by(tool))
+        if let Some((pose, lifted)) = self.next_pose(tool) {
+            self.place_tool(pose, lifted)
                 .map_err(|e| StepError::Failed(e.to_string()))?;
         }
         match self.body.step_frame() {

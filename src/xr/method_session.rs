@@ -423,8 +423,7 @@ impl HeadsetSim for Session {
         // The controller's blade where it holds the tool; the scene's scripted blade
         // (where the method's tool is a scalpel) while the script holds it.
         self.drawn_tool = match tool {
-            ToolInput::Hand { pose, .. } if cmd.pose.is_some() => Some(pose),
-            ToolInput::Hand { .. } => None,
+            ToolInput::Hand { pose, .. } => tracked.then_some(pose),
             ToolInput::Script => step.scalpel,
         };
         if let Some(view) = step.view {
