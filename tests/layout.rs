@@ -191,3 +191,85 @@ fn a_circle_of_imports_is_found() {
     cut.insert(vec!["c".into()], "// crate::a::go()".into());
     assert_eq!(circle(&imports(&cut)), None, "a comment is not an import");
 }
+
+/// Every `include_str!`/`include_bytes!` in the `.rs` files under `src`, as (including
+/// file, included file) with the included path resolved against the including file.
+fn includes(src: &Path) -> Vec<(std::path::PathBuf, std::path::PathBuf)> {
+    let mut out = Vec::new();
+    let mut dirs = vec![src.to_path_buf()];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                let text = std::fs::read_to_string(&path).unwrap();
+                for part in text.split("include_").skip(1) {
+                    let Some(rest) = part
+                        .strip_prefix("str!(\"")
+                        .or_else(|| part.strip_prefix("bytes!(\""))
+                    else {
+                        continue;
+                    };
+                    let name = &rest[..rest.find('"').unwrap()];
+                    out.push((path.clone(), path.parent().unwrap().join(name)));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Every `.wgsl` file under `dir`.
+fn wgsl_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy();
+        if path.is_dir() && !name.starts_with('.') && name != "target" {
+            wgsl_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            out.push(path);
+        }
+    }
+}
+
+/// Each crate stands alone: what it compiles in (`include_str!`, `include_bytes!`) lies
+/// inside its own folder (the app's: outside `crates/`), and every WGSL file of the
+/// repository is compiled in by a module of the crate it sits in.
+#[test]
+fn each_crate_compiles_in_only_its_own_files_and_every_shader_is_used() {
+    let root = std::fs::canonicalize(env!("CARGO_MANIFEST_DIR")).unwrap();
+    let mut used = BTreeSet::new();
+    for krate in ["", "crates/sim", "crates/scalpel", "crates/xr"] {
+        let home = root.join(krate);
+        for (from, file) in includes(&home.join("src")) {
+            let file = std::fs::canonicalize(&file)
+                .unwrap_or_else(|e| panic!("{}: {}: {e}", from.display(), file.display()));
+            let inside = file.starts_with(&home)
+                && (!krate.is_empty() || !file.starts_with(root.join("crates")));
+            assert!(
+                inside,
+                "{} compiles in {}, outside its crate {}",
+                from.display(),
+                file.display(),
+                home.display()
+            );
+            used.insert(file);
+        }
+    }
+    let mut shaders = Vec::new();
+    wgsl_files(&root, &mut shaders);
+    assert!(
+        shaders.len() >= 18,
+        "only {} WGSL files found",
+        shaders.len()
+    );
+    for s in shaders {
+        let s = std::fs::canonicalize(&s).unwrap();
+        assert!(
+            used.contains(&s),
+            "{} is compiled in by no module",
+            s.display()
+        );
+    }
+}

@@ -1,5 +1,5 @@
 //! The stress heat map's colour scale on the host (for legends), the same polynomial as
-//! `fs_stress` in `shaders/tet_faces.wgsl`.
+//! `fs_stress` in `shaders/render/tet_faces.wgsl`.
 
 /// Turbo colour map (Mikhailov 2019, polynomial fit): sRGB in [0, 1] for `t` in [0, 1]
 /// (clamped).

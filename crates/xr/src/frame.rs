@@ -101,7 +101,7 @@ pub enum ShadingMode {
 }
 
 /// The flat colours of [`ShadingMode::MaterialIds`], by material name, as the bytes of an
-/// sRGB image (the `ID_*` constants of `shaders/render_common.wgsl` are their linear values).
+/// sRGB image (the `ID_*` constants of `shaders/render/render_common.wgsl` are their linear values).
 pub const MATERIAL_IDS: [(&str, [u8; 3]); 9] = [
     ("skin", [0, 255, 0]),
     ("skin_back", [0, 0, 255]),

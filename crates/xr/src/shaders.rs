@@ -1,9 +1,10 @@
-//! The WGSL sources of the renderer (`shaders/`): render shaders get
-//! `render_common.wgsl` (globals and tissue shading) prepended; compute shaders stand alone.
+//! The WGSL sources of the renderer, in `shaders/render/` and `shaders/compute/` beside
+//! this file: render shaders get `render_common.wgsl` (globals and tissue shading)
+//! prepended; compute shaders stand alone.
 
-const COMMON: &str = include_str!("../../../shaders/render_common.wgsl");
+const COMMON: &str = include_str!("shaders/render/render_common.wgsl");
 
-/// Render shaders (each `shaders/<name>.wgsl`, with the common part prepended).
+/// Render shaders (each `shaders/render/<name>.wgsl`, with the common part prepended).
 pub const RENDER_SHADERS: [&str; 7] = [
     "skin",
     "tet_faces",
@@ -15,23 +16,23 @@ pub const RENDER_SHADERS: [&str; 7] = [
 ];
 
 /// Compute shaders of the node world positions and the skin deformation (each
-/// `shaders/<name>.wgsl`).
+/// `shaders/compute/<name>.wgsl`).
 pub const COMPUTE_SHADERS: [&str; 3] = ["node_world", "skin_deform", "skin_normals"];
 
 /// Full WGSL source of a renderer shader, or `None` if unknown.
 pub fn source(name: &str) -> Option<String> {
     let render = |body: &str| format!("{COMMON}\n{body}");
     Some(match name {
-        "skin" => render(include_str!("../../../shaders/skin.wgsl")),
-        "tet_faces" => render(include_str!("../../../shaders/tet_faces.wgsl")),
-        "wireframe" => render(include_str!("../../../shaders/wireframe.wgsl")),
-        "markers" => render(include_str!("../../../shaders/markers.wgsl")),
-        "tool" => render(include_str!("../../../shaders/tool.wgsl")),
-        "surface_line" => render(include_str!("../../../shaders/surface_line.wgsl")),
-        "panel" => render(include_str!("../../../shaders/panel.wgsl")),
-        "node_world" => include_str!("../../../shaders/node_world.wgsl").to_string(),
-        "skin_deform" => include_str!("../../../shaders/skin_deform.wgsl").to_string(),
-        "skin_normals" => include_str!("../../../shaders/skin_normals.wgsl").to_string(),
+        "skin" => render(include_str!("shaders/render/skin.wgsl")),
+        "tet_faces" => render(include_str!("shaders/render/tet_faces.wgsl")),
+        "wireframe" => render(include_str!("shaders/render/wireframe.wgsl")),
+        "markers" => render(include_str!("shaders/render/markers.wgsl")),
+        "tool" => render(include_str!("shaders/render/tool.wgsl")),
+        "surface_line" => render(include_str!("shaders/render/surface_line.wgsl")),
+        "panel" => render(include_str!("shaders/render/panel.wgsl")),
+        "node_world" => include_str!("shaders/compute/node_world.wgsl").to_string(),
+        "skin_deform" => include_str!("shaders/compute/skin_deform.wgsl").to_string(),
+        "skin_normals" => include_str!("shaders/compute/skin_normals.wgsl").to_string(),
         _ => return None,
     })
 }

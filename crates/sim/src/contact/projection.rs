@@ -1,6 +1,6 @@
 //! Projection of one node onto the tool's surface for one substep (PHYSICS.md §1.5:
 //! `C = d(x) ≥ 0` along ∇d, infinitely stiff), continuous over the substep and with
-//! positional Coulomb friction. The WGSL twin is `shaders/contact.wgsl`.
+//! positional Coulomb friction. The WGSL twin is `gpu/shaders/contact.wgsl`.
 
 use glam::Vec3;
 

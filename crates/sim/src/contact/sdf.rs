@@ -1,6 +1,6 @@
 //! Signed distances of the tool's primitives (PHYSICS.md §1.5): `d(x) = ‖x − c‖ − r` for
 //! a sphere, the exact box distance for the body; negative inside. The WGSL twin is in
-//! `shaders/contact.wgsl`.
+//! `gpu/shaders/contact.wgsl`.
 
 use glam::{Mat3, Vec3};
 

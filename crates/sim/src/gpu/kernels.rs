@@ -1,6 +1,6 @@
 //! The WGSL kernels: sources (common.wgsl prepended to each stage) and compiled pipelines.
 
-/// The compute stages, in the order a frame runs them; each is `shaders/<name>.wgsl`.
+/// The compute stages, in the order a frame runs them; each is `gpu/shaders/<name>.wgsl`.
 pub const SHADER_STAGES: [&str; 6] = [
     "predict",
     "neo_hookean",
@@ -10,17 +10,17 @@ pub const SHADER_STAGES: [&str; 6] = [
     "release",
 ];
 
-const COMMON: &str = include_str!("../../../../shaders/common.wgsl");
+const COMMON: &str = include_str!("shaders/common.wgsl");
 
 /// Full WGSL source of a stage (common definitions + the stage), or `None` if unknown.
 pub fn shader_source(stage: &str) -> Option<String> {
     let body = match stage {
-        "predict" => include_str!("../../../../shaders/predict.wgsl"),
-        "neo_hookean" => include_str!("../../../../shaders/neo_hookean.wgsl"),
-        "contact" => include_str!("../../../../shaders/contact.wgsl"),
-        "velocity" => include_str!("../../../../shaders/velocity.wgsl"),
-        "stress" => include_str!("../../../../shaders/stress.wgsl"),
-        "release" => include_str!("../../../../shaders/release.wgsl"),
+        "predict" => include_str!("shaders/predict.wgsl"),
+        "neo_hookean" => include_str!("shaders/neo_hookean.wgsl"),
+        "contact" => include_str!("shaders/contact.wgsl"),
+        "velocity" => include_str!("shaders/velocity.wgsl"),
+        "stress" => include_str!("shaders/stress.wgsl"),
+        "release" => include_str!("shaders/release.wgsl"),
         _ => return None,
     };
     Some(format!("{COMMON}\n{body}"))

@@ -1,4 +1,4 @@
-//! Host mirrors of the WGSL structs in `shaders/common.wgsl` (byte-for-byte layouts).
+//! Host mirrors of the WGSL structs in `gpu/shaders/common.wgsl` (byte-for-byte layouts).
 
 use bytemuck::{Pod, Zeroable};
 

@@ -1,4 +1,4 @@
-//! The XPBD solver on the GPU (wgpu compute, kernels in `shaders/`): prediction, coloured
+//! The XPBD solver on the GPU (wgpu compute, kernels in `gpu/shaders/`): prediction, coloured
 //! Neo-Hookean projection, velocity update, stress and release run on the device with no
 //! per-substep readback. The CPU solver is the reference it must match; it also serves as
 //! the host mirror (mesh, cut state, guards, statistics), so those exist once.

@@ -101,7 +101,7 @@ impl Strain {
 }
 
 /// `x − ln(1 + x)` for `x > −1`, accurate near 0 (series below [`SERIES_LIMIT`]); the
-/// same operations as `log1p_excess` in `shaders/neo_hookean.wgsl`.
+/// same operations as `log1p_excess` in `gpu/shaders/neo_hookean.wgsl`.
 #[inline]
 pub fn log1p_excess(x: f32) -> f32 {
     if x.abs() < SERIES_LIMIT {
