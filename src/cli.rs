@@ -198,7 +198,8 @@ pub enum Command {
         json: bool,
         /// Print the table as the markdown rows of docs/performance.md, under a line giving
         /// the command, machine (CPU model, cores), UTC date and load average (`realtime`:
-        /// both CPU kernels interleaved, three runs each, unless `--cpu-kernel` names one).
+        /// the CPU kernels and sweeps interleaved, three runs each, on one thread and on
+        /// all, unless `--cpu-kernel` names one).
         #[arg(long, conflicts_with = "json")]
         markdown: bool,
         /// Frames to time per case (after 2 warm-up frames; the solver target interleaves
@@ -223,6 +224,9 @@ pub enum Command {
         /// CPU projection kernel of the `realtime` target (default: the scene's).
         #[arg(long, value_enum)]
         cpu_kernel: Option<KernelChoice>,
+        /// CPU sweep order of the `realtime` target (default: the scene's).
+        #[arg(long, value_enum)]
+        cpu_sweep: Option<SweepChoice>,
     },
     /// Endurance run: cut a scalpel scene, reset, cut again for a wall-clock duration;
     /// fails (exit 1) if memory grows > 5 %, file descriptors leak or a cut differs.
@@ -422,6 +426,25 @@ impl From<KernelChoice> for incise_sim::xpbd::CpuKernel {
             KernelChoice::Lanes => incise_sim::xpbd::CpuKernel::Lanes,
             KernelChoice::PortableLanes => incise_sim::xpbd::CpuKernel::PortableLanes,
             KernelChoice::Scalar => incise_sim::xpbd::CpuKernel::Scalar,
+        }
+    }
+}
+
+/// In which order the CPU sweeps the tets (`incise bench realtime --cpu-sweep`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SweepChoice {
+    /// One pass per colour over the whole mesh (the reference order).
+    Coloured,
+    /// Fixed slabs of the mesh, each colour after colour by one task: four
+    /// synchronisations a sweep.
+    Blocks,
+}
+
+impl From<SweepChoice> for incise_sim::xpbd::CpuSweep {
+    fn from(k: SweepChoice) -> Self {
+        match k {
+            SweepChoice::Coloured => incise_sim::xpbd::CpuSweep::Coloured,
+            SweepChoice::Blocks => incise_sim::xpbd::CpuSweep::Blocks,
         }
     }
 }

@@ -185,12 +185,17 @@ fn main() -> ExitCode {
             scene,
             threads,
             cpu_kernel,
+            cpu_sweep,
             markdown,
             ..
         } => bench_realtime::run(
             &scene,
             device,
-            (threads, cpu_kernel.map(Into::into)),
+            (
+                threads,
+                cpu_kernel.map(Into::into),
+                cpu_sweep.map(Into::into),
+            ),
             frames,
             bench::BenchOutput::of(json, markdown),
         ),

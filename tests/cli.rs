@@ -271,6 +271,15 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
         (f("frames_per_second") - 1e3 / f("frame_ms_median")).abs() < 1e-6,
         "{r}"
     );
+    // What a sweep did: the counted flops of every tet's projection, at the sweep's time.
+    let flops = f("flops_per_sweep");
+    assert!(flops >= 250.0 * 24576.0, "{r}");
+    let gflops = flops / (f("sweep_ms_median") * 1e6);
+    assert!((f("gflops") - gflops).abs() <= 1e-9 * gflops, "{r}");
+    assert!(
+        r["passes_per_frame"].as_u64().unwrap() > 2 * 24,
+        "a pass per colour per substep: {r}"
+    );
     let o = incise(&[&["bench", "realtime", "--markdown"][..], &scene].concat());
     assert!(o.status.success(), "{}", text(&o.stderr));
     let out = text(&o.stdout);
@@ -286,7 +295,28 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
         .filter(|l| l.starts_with("| config/plate_cut.ron |"))
         .map(|l| l.split('|').map(str::trim).nth(5).unwrap())
         .collect();
-    assert_eq!(kernels, ["Scalar", "PortableLanes", "Lanes"], "{out}");
+    assert_eq!(
+        kernels,
+        ["Scalar", "PortableLanes", "Lanes", "Lanes, Blocks"],
+        "{out}"
+    );
+    // Each kernel's sweep on one thread and on all, and the ratio of the two.
+    for row in out
+        .lines()
+        .filter(|l| l.starts_with("| config/plate_cut.ron |"))
+    {
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        let (one, all) = cells[8].split_once(" / ").unwrap();
+        let (one, all): (f64, f64) = (one.parse().unwrap(), all.parse().unwrap());
+        let scaling: f64 = cells[9].trim_end_matches('×').parse().unwrap();
+        assert!(one > 0.0 && all > 0.0, "{row}");
+        assert!((scaling - one / all).abs() < 0.01 + 0.01 * scaling, "{row}");
+        assert!(cells[10].parse::<f64>().unwrap() > 0.0, "GFLOP/s: {row}");
+    }
+    assert!(
+        out.contains("Flops of a sweep: ") && out.contains(" per tet projection"),
+        "{out}"
+    );
 }
 
 /// Every shipped scene parses, resolves its material and builds a stable solver.

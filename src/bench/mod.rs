@@ -2,6 +2,7 @@
 //! 34k-tet intestine, serial and with all threads on the CPU, or on the GPU; optionally
 //! the intestine scaling series (≈34k, 140k, 550k, 1.1M tets); plus memory.
 
+pub mod peak;
 pub mod realtime;
 pub mod render;
 pub mod scene;

@@ -1,13 +1,17 @@
 //! `incise bench realtime`: the default scene (config/intestine_pull.ron) at its own
 //! substeps, as a trainee would run it — per-frame wall ms (median, p99) split into the
 //! substeps, the release checks inside them, and the end-of-frame stress, guards and
-//! release; frames per second; on the CPU or the GPU (issue 17, item 6).
+//! release; frames per second; on the CPU or the GPU (issue 17, item 6). Per kernel also
+//! what a sweep costs against its arithmetic (issue 35, item 5): ms per sweep on one
+//! thread and on all, their ratio, GFLOP/s from the counted flops of a projection
+//! ([`incise_sim::xpbd::projection_flops`]) against the machine's peak
+//! ([`crate::bench::peak`]), and the parallel passes (GPU: dispatches) of a frame.
 
 use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use incise_sim::xpbd::CpuKernel;
+use incise_sim::xpbd::{CpuKernel, CpuSweep, NODE_FLOPS_PER_SUBSTEP, projection_flops};
 use serde::Serialize;
 
 use crate::bench::soak::percentile;
@@ -20,10 +24,15 @@ pub struct RealtimeResult {
     pub scene: String,
     /// "cpu (N threads)" or the GPU adapter.
     pub device: String,
-    /// The CPU projection kernel ("Lanes", "PortableLanes" or "Scalar"; the GPU ignores it).
+    /// The CPU projection kernel ("Lanes", "PortableLanes" or "Scalar"; the GPU ignores
+    /// it), with ", Blocks" for the partitioned sweep.
     pub cpu_kernel: String,
+    /// CPU solver threads (0 on the GPU).
+    pub threads: usize,
     /// Tets.
     pub tets: usize,
+    /// Nodes.
+    pub nodes: usize,
     /// Substeps per frame (the scene's).
     pub substeps: u32,
     /// Frame length, s.
@@ -40,14 +49,25 @@ pub struct RealtimeResult {
     pub release_checks_ms_median: f64,
     /// Median ms of the end-of-frame stress, guards and release hand-over.
     pub stress_ms_median: f64,
+    /// Median ms of one sweep (an XPBD substep: prediction, one projection of every
+    /// tet, contact, velocities).
+    pub sweep_ms_median: f64,
+    /// Flops of one sweep: tets × the counted flops of a projection + nodes × the
+    /// prediction's and velocity update's.
+    pub flops_per_sweep: f64,
+    /// GFLOP/s achieved at the median sweep.
+    pub gflops: f64,
+    /// Median parallel passes of a frame (CPU: colour and stress passes, each a
+    /// synchronisation of the threads; GPU: compute dispatches).
+    pub passes_per_frame: u32,
     /// Frames per second of wall time at the median frame.
     pub frames_per_second: f64,
     /// Whether the median frame fits the scene's frame length in wall time.
     pub real_time: bool,
 }
 
-/// CPU threads (default: the scene's) and projection kernel (default: the scene's).
-pub type CpuChoice = (Option<usize>, Option<CpuKernel>);
+/// CPU threads, projection kernel and sweep order (each by default the scene's).
+pub type CpuChoice = (Option<usize>, Option<CpuKernel>, Option<CpuSweep>);
 
 /// Interleaved runs per kernel of the `--markdown` table.
 pub const MARKDOWN_RUNS: usize = 3;
@@ -65,17 +85,26 @@ pub fn run(
     use crate::bench::BenchOutput;
     if output == BenchOutput::Markdown {
         let kernels = match cpu.1 {
-            Some(k) => vec![k],
+            Some(k) => vec![(k, cpu.2)],
             None => vec![
-                CpuKernel::Scalar,
-                CpuKernel::PortableLanes,
-                CpuKernel::Lanes,
+                (CpuKernel::Scalar, Some(CpuSweep::Coloured)),
+                (CpuKernel::PortableLanes, Some(CpuSweep::Coloured)),
+                (CpuKernel::Lanes, Some(CpuSweep::Coloured)),
+                (CpuKernel::Lanes, Some(CpuSweep::Blocks)),
             ],
         };
-        let mut runs: Vec<Vec<RealtimeResult>> = vec![Vec::new(); kernels.len()];
+        let on_cpu = device != DeviceChoice::Gpu;
+        let mut runs: Vec<KernelRuns> = vec![KernelRuns::default(); kernels.len()];
         for _ in 0..MARKDOWN_RUNS {
-            for (k, kernel) in kernels.iter().enumerate() {
-                runs[k].push(measure(scene, device, (cpu.0, Some(*kernel)), frames)?);
+            for (k, (kernel, sweep)) in kernels.iter().enumerate() {
+                let choice = |threads| (threads, Some(*kernel), *sweep);
+                runs[k]
+                    .all
+                    .push(measure(scene, device, choice(cpu.0), frames)?);
+                if on_cpu {
+                    let one = measure(scene, device, choice(Some(1)), frames)?;
+                    runs[k].one.push(one);
+                }
             }
         }
         print!("{}", markdown(&runs));
@@ -94,7 +123,8 @@ pub fn run(
 fn summary(r: &RealtimeResult) -> String {
     format!(
         "{} on {} ({} kernel): {} tets, {} substeps/frame: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
-         substeps {:.1} ms, release checks {:.1} ms, stress+guards {:.1} ms{}",
+         substeps {:.1} ms, release checks {:.1} ms, stress+guards {:.1} ms; \
+         {:.3} ms a sweep, {:.2} GFLOP/s, {} passes a frame{}",
         r.scene,
         r.device,
         r.cpu_kernel,
@@ -106,45 +136,85 @@ fn summary(r: &RealtimeResult) -> String {
         r.substeps_ms_median,
         r.release_checks_ms_median,
         r.stress_ms_median,
+        r.sweep_ms_median,
+        r.gflops,
+        r.passes_per_frame,
         if r.real_time { " (real time)" } else { "" }
     )
 }
 
-/// The runs of each kernel (one inner list per kernel) as docs/performance.md's
-/// realtime table: min and median over the runs of each run's median frame.
-pub fn markdown(runs: &[Vec<RealtimeResult>]) -> String {
+/// The interleaved runs of one kernel: on all threads (or the GPU) and on one thread.
+#[derive(Debug, Clone, Default)]
+pub struct KernelRuns {
+    /// Runs on the asked threads (default all cores), or on the GPU.
+    pub all: Vec<RealtimeResult>,
+    /// Runs on one thread (none on the GPU).
+    pub one: Vec<RealtimeResult>,
+}
+
+/// Median over `rs` of `f`.
+fn median_of(rs: &[RealtimeResult], f: impl Fn(&RealtimeResult) -> f64) -> f64 {
+    let mut v: Vec<f64> = rs.iter().map(f).collect();
+    v.sort_by(f64::total_cmp);
+    percentile(&v, 0.5)
+}
+
+/// The runs of each kernel as docs/performance.md's realtime table: min and median over
+/// the runs of each run's median frame; the sweep on one thread and on all, their ratio,
+/// GFLOP/s and the share of the machine's peak on all threads; then how the peak and the
+/// flops were counted.
+pub fn markdown(runs: &[KernelRuns]) -> String {
     let mut s = format!(
-        "{}\n\n| scene | device | tets | substeps / frame | kernel | ms/frame min / median | fps (median) | ms per substep | release checks ms | stress + guards ms |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
+        "{}\n\n| scene | device | tets | substeps / frame | kernel | ms/frame min / median | fps (median) | ms per sweep, 1 thread / all | 1 → all threads | GFLOP/s | % of peak | passes / frame | release checks ms | stress + guards ms |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         crate::provenance::generated_by()
     );
-    for rs in runs.iter().filter(|rs| !rs.is_empty()) {
-        let mid = |f: &dyn Fn(&RealtimeResult) -> f64| {
-            let mut v: Vec<f64> = rs.iter().map(f).collect();
-            v.sort_by(f64::total_cmp);
-            percentile(&v, 0.5)
-        };
-        let median = mid(&|r| r.frame_ms_median);
+    let mut peak = None;
+    for k in runs.iter().filter(|k| !k.all.is_empty()) {
+        let rs = &k.all;
+        let median = median_of(rs, |r| r.frame_ms_median);
         let min = rs
             .iter()
             .map(|r| r.frame_ms_median)
             .fold(f64::INFINITY, f64::min);
         let r = &rs[0];
+        let sweep = median_of(rs, |r| r.sweep_ms_median);
+        let gflops = median_of(rs, |r| r.gflops);
+        let (one, scaling) = match k.one.is_empty() {
+            true => ("–".to_string(), "–".to_string()),
+            false => {
+                let one = median_of(&k.one, |r| r.sweep_ms_median);
+                (format!("{one:.3}"), format!("{:.2}×", one / sweep))
+            }
+        };
+        peak = (r.threads > 0)
+            .then(|| crate::bench::peak::peak(r.threads))
+            .flatten();
+        let share = peak.as_ref().map_or("–".to_string(), |p| {
+            format!("{:.1} %", 100.0 * gflops / p.gflops)
+        });
         s += &format!(
-            "| {} | {} | {} | {} | {} | {:.1} / {:.1} | {:.1} | {:.2} | {:.1} | {:.2} |\n",
+            "| {} | {} | {} | {} | {} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep:.3} | {scaling} | {gflops:.2} | {share} | {} | {:.1} | {:.2} |\n",
             r.scene,
             r.device,
             r.tets,
             r.substeps,
             r.cpu_kernel,
-            min,
-            median,
             1e3 / median,
-            mid(&|r| r.substeps_ms_median) / r.substeps as f64,
-            mid(&|r| r.release_checks_ms_median),
-            mid(&|r| r.stress_ms_median),
+            median_of(rs, |r| r.passes_per_frame as f64),
+            median_of(rs, |r| r.release_checks_ms_median),
+            median_of(rs, |r| r.stress_ms_median),
         );
     }
+    s += &format!(
+        "\nFlops of a sweep: {} per tet projection (counted: `incise_sim::xpbd::projection_flops`) \
+         + {NODE_FLOPS_PER_SUBSTEP} per node. Peak: {}.\n",
+        projection_flops(),
+        peak.map_or("not known on this system".to_string(), |p| format!(
+            "{} = {:.0} GFLOP/s (`cpu MHz` of /proc/cpuinfo, two FMA pipes a core)",
+            p.how, p.gflops
+        ))
+    );
     s
 }
 
@@ -152,15 +222,27 @@ pub fn markdown(runs: &[Vec<RealtimeResult>]) -> String {
 pub fn measure(
     scene_path: &Path,
     device: DeviceChoice,
-    (threads, kernel): CpuChoice,
+    (threads, kernel, sweep): CpuChoice,
     frames: u32,
 ) -> Result<RealtimeResult> {
     let mut scene = crate::scene::load_scene(scene_path)?;
     if let Some(k) = kernel {
         scene.solver.cpu_kernel = k;
     }
+    if let Some(s) = sweep {
+        scene.solver.cpu_sweep = s;
+    }
     let built = crate::scene::build_scene(&scene, scene_path, threads)?;
-    let cpu_kernel = format!("{:?}", built.solver.params().cpu_kernel);
+    let params = built.solver.params();
+    let cpu_kernel = match params.cpu_sweep {
+        CpuSweep::Coloured => format!("{:?}", params.cpu_kernel),
+        CpuSweep::Blocks => format!("{:?}, Blocks", params.cpu_kernel),
+    };
+    let cpu_threads = match built.solver.params().threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    };
+    let nodes = built.solver.mesh().node_count();
     let (tets, substeps, frame_dt) = (
         built.solver.mesh().tet_count(),
         built.solver.params().substeps,
@@ -169,8 +251,8 @@ pub fn measure(
     let stroke = built.tool.as_ref().and_then(|t| t.stroke.clone());
     let mut body = Body::place(built.solver, device, |m| eprintln!("note: {m}"))
         .with_context(|| format!("{}: placing the body", scene_path.display()))?;
-    let (mut frame, mut solve, mut checks, mut stress) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut frame, mut solve, mut checks, mut stress, mut passes) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for f in 0..frames.max(1) as u64 + 2 {
         if let Some(s) = &stroke {
             body.move_tool(s.pose_at((f + 1) as f64 * frame_dt as f64));
@@ -184,18 +266,35 @@ pub fn measure(
             solve.push(st.solve_ms - st.check_ms);
             checks.push(st.check_ms);
             stress.push(st.stress_ms);
+            passes.push(st.passes as f64);
         }
     }
-    for v in [&mut frame, &mut solve, &mut checks, &mut stress] {
+    for v in [
+        &mut frame,
+        &mut solve,
+        &mut checks,
+        &mut stress,
+        &mut passes,
+    ] {
         v.sort_by(f64::total_cmp);
     }
     let median = |v: &[f64]| percentile(v, 0.5);
     let frame_ms_median = median(&frame);
+    let sweep_ms_median = median(&solve) / substeps as f64;
+    let flops_per_sweep =
+        (tets as u64 * projection_flops() + nodes as u64 * NODE_FLOPS_PER_SUBSTEP) as f64;
+    let device_name = body.device();
     Ok(RealtimeResult {
         scene: scene_path.display().to_string(),
-        device: body.device(),
+        threads: if device_name.starts_with("cpu") {
+            cpu_threads
+        } else {
+            0
+        },
+        device: device_name,
         cpu_kernel,
         tets,
+        nodes,
         substeps,
         frame_dt,
         frames: frame.len(),
@@ -204,6 +303,10 @@ pub fn measure(
         substeps_ms_median: median(&solve),
         release_checks_ms_median: median(&checks),
         stress_ms_median: median(&stress),
+        sweep_ms_median,
+        flops_per_sweep,
+        gflops: flops_per_sweep / (sweep_ms_median * 1e6),
+        passes_per_frame: median(&passes) as u32,
         frames_per_second: 1e3 / frame_ms_median,
         real_time: frame_ms_median <= frame_dt as f64 * 1e3,
     })

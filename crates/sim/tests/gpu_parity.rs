@@ -169,7 +169,7 @@ fn gpu_rollback_restores_the_live_flags() {
     assert!(cpu.step_frame().is_err() && gpu.step_frame().is_err());
     let device_live = read_u32(&ctx, gpu.live_buffer());
     let host = gpu.host();
-    for (slot, &t) in host_tet_of_slot(host).iter().enumerate() {
+    for (slot, &t) in host.slot_tets().iter().enumerate() {
         assert_eq!(
             device_live[slot] != 0,
             host.cut().is_live(t as usize),
@@ -177,14 +177,6 @@ fn gpu_rollback_restores_the_live_flags() {
         );
     }
     assert_eq!(cpu.cut().live(), gpu.host().cut().live());
-}
-
-/// Mesh tet of each colour-ordered slot (the order the device keeps per-tet data in).
-fn host_tet_of_slot(s: &incise_sim::Solver) -> Vec<u32> {
-    let colors = incise_sim::xpbd::greedy_tet_colors(s.mesh().node_count(), &s.mesh().tets).0;
-    let mut order: Vec<u32> = (0..s.mesh().tet_count() as u32).collect();
-    order.sort_by_key(|&t| (colors[t as usize], t));
-    order
 }
 
 /// Read a `u32` storage buffer back from the device.
@@ -204,4 +196,30 @@ fn read_u32(ctx: &incise_sim::gpu::GpuContext, buf: &wgpu::Buffer) -> Vec<u32> {
         .expect("poll");
     let data = staging.slice(..).get_mapped_range().expect("mapped");
     bytemuck::cast_slice(&data).to_vec()
+}
+
+/// A frame's parallel passes are counted as they run (issue 35: the bench reports them):
+/// on the CPU a pass per colour per substep, one per release check and one for the
+/// end-of-frame stress; on the GPU every dispatch (the frame's clear, prediction, the
+/// colours and velocities per substep, three per release check, the stress).
+#[test]
+fn a_frames_passes_are_counted_on_both_solvers() {
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
+    let mut cpu = common::tearing_bar(1);
+    let mut gpu = GpuSolver::new(common::tearing_bar(1), &ctx).expect("upload");
+    let p = cpu.params().clone();
+    let (n, colours) = (p.substeps, cpu.color_count() as u32);
+    let checks = incise_sim::xpbd::release_checks(0.0, p.substep(), n, p.release_interval);
+    let stress = u32::from(checks.last() != Some(&(n - 1)));
+    let checks = checks.len() as u32;
+    assert_eq!(
+        cpu.step_frame().unwrap().passes,
+        n * colours + checks + stress
+    );
+    assert_eq!(
+        gpu.step_frame().unwrap().passes,
+        1 + n * (2 + colours) + 3 * checks + stress
+    );
 }

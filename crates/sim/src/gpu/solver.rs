@@ -531,7 +531,7 @@ impl GpuSolver {
             enc.clear_buffer(&self.buf.push, 0, None);
         }
 
-        self.record_frame(&mut enc);
+        self.host.passes = self.record_frame(&mut enc);
         if with_tool {
             enc.copy_buffer_to_buffer(&self.buf.push, 0, &self.read.push, 0, n * 16);
             enc.copy_buffer_to_buffer(&self.buf.near_edge, 0, &self.read.near_edge, 0, n * 4);
@@ -644,8 +644,8 @@ impl GpuSolver {
         }
     }
 
-    /// All dispatches of one frame in one compute pass.
-    fn record_frame(&self, enc: &mut wgpu::CommandEncoder) {
+    /// All dispatches of one frame in one compute pass; returns how many.
+    fn record_frame(&self, enc: &mut wgpu::CommandEncoder) -> u32 {
         let n = self.host.x.len();
         let timestamp_writes =
             self.timestamps
@@ -668,6 +668,7 @@ impl GpuSolver {
         pass.set_pipeline(&k.clear_frame);
         pass.set_bind_group(0, &self.bind.clear_frame, &[]);
         pass.dispatch_workgroups(groups(n), 1, 1);
+        let mut dispatches = 1;
         for s in 0..self.host.params.substeps as usize {
             pass.set_pipeline(&k.predict);
             pass.set_bind_group(0, &self.bind.predict, &[]);
@@ -679,7 +680,9 @@ impl GpuSolver {
                 pass.set_bind_group(1, &self.bind.project_steps[c], &[]);
                 pass.dispatch_workgroups(groups(r.len()), 1, 1);
             }
+            dispatches += 2 + self.host.color_ranges.len() as u32;
             if self.host.tool.is_some() {
+                dispatches += 1;
                 pass.set_pipeline(&k.contact);
                 pass.set_bind_group(0, &self.bind.contact, &[]);
                 pass.set_bind_group(1, &self.bind.contact_steps[s], &[]);
@@ -690,24 +693,28 @@ impl GpuSolver {
             pass.dispatch_workgroups(groups(n), 1, 1);
             fresh = checks.contains(&(s as u32));
             if fresh {
-                self.record_release_check(&mut pass);
+                dispatches += self.record_release_check(&mut pass);
             }
         }
         if !fresh {
             // Stress and det F at the end of the frame, for the guards and the report.
-            self.record_stress(&mut pass);
+            dispatches += self.record_stress(&mut pass);
         }
+        dispatches
     }
 
-    fn record_stress(&self, pass: &mut wgpu::ComputePass<'_>) {
+    /// The stress pass; returns its dispatch count (1).
+    fn record_stress(&self, pass: &mut wgpu::ComputePass<'_>) -> u32 {
         pass.set_pipeline(&self.kernels.stress);
         pass.set_bind_group(0, &self.bind.stress, &[]);
         pass.dispatch_workgroups(groups(self.host.slots.len()), 1, 1);
+        1
     }
 
     /// Stress, release and the restart of the cut-zone window (PHYSICS.md §1.4 on the
-    /// fixed interval; CPU twin: the check in `Solver::run_substeps`).
-    fn record_release_check(&self, pass: &mut wgpu::ComputePass<'_>) {
+    /// fixed interval; CPU twin: the check in `Solver::run_substeps`); returns its
+    /// dispatch count.
+    fn record_release_check(&self, pass: &mut wgpu::ComputePass<'_>) -> u32 {
         self.record_stress(pass);
         pass.set_pipeline(&self.kernels.release);
         pass.set_bind_group(0, &self.bind.release, &[]);
@@ -715,6 +722,7 @@ impl GpuSolver {
         pass.set_pipeline(&self.kernels.clear_window);
         pass.set_bind_group(0, &self.bind.clear_window, &[]);
         pass.dispatch_workgroups(groups(self.host.x.len()), 1, 1);
+        3
     }
 
     /// Map the staging buffers, copy into the host mirror; returns released slots.
@@ -935,7 +943,7 @@ fn finite_or_none(alpha: f32) -> f32 {
     if alpha.is_finite() { alpha } else { -1.0 }
 }
 
-/// Append one pose block of the `tool` buffer (layout in `shaders/contact.wgsl`).
+/// Append one pose block of the `tool` buffer (layout in `gpu/shaders/contact.wgsl`).
 fn push_placed(words: &mut Vec<[f32; 4]>, placed: &PlacedTool) {
     words.push([placed.lo.x, placed.lo.y, placed.lo.z, 0.0]);
     words.push([placed.hi.x, placed.hi.y, placed.hi.z, 0.0]);

@@ -38,4 +38,7 @@ pub struct FrameStats {
     pub check_ms: f64,
     /// Wall time of stress, guards and release, ms.
     pub stress_ms: f64,
+    /// Parallel passes of the frame: on the CPU the colour and stress passes (each ends
+    /// in a synchronisation of the threads), on the GPU the compute dispatches.
+    pub passes: u32,
 }

@@ -26,6 +26,19 @@ pub enum CpuKernel {
     Scalar,
 }
 
+/// In which order the CPU projects one sweep's tets (PHYSICS.md §1.2, parallel form).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum CpuSweep {
+    /// One pass per colour over the whole mesh, the threads synchronising after each: the
+    /// reference order, which the GPU follows too.
+    #[default]
+    Coloured,
+    /// The mesh in fixed slabs (`xpbd/sweep_plan.rs`): each slab's tets colour after
+    /// colour by one task, then the tets across slabs; four synchronisations a sweep.
+    /// Another Gauss–Seidel order: the same converged answer, not the same rounding.
+    Blocks,
+}
+
 /// Settings of the XPBD small-steps solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -58,6 +71,8 @@ pub struct SolverParams {
     /// How the CPU projects the rest-free coupled pair: `Lanes` (default, eight tets at
     /// once in SIMD lanes) or `Scalar` (the readable reference, one tet at a time).
     pub cpu_kernel: CpuKernel,
+    /// The order of a CPU sweep: `Coloured` (default) or `Blocks` (fewer synchronisations).
+    pub cpu_sweep: CpuSweep,
     /// von Mises stress above which a tet is released, Pa; `None` disables cutting.
     pub release_threshold: Option<f32>,
     /// Where the stress criterion may release tets: `Anywhere` (tearing) or
@@ -81,6 +96,7 @@ impl Default for SolverParams {
             release_interval: Some(DEFAULT_RELEASE_INTERVAL),
             threads: 0,
             cpu_kernel: CpuKernel::Lanes,
+            cpu_sweep: CpuSweep::Coloured,
             release_threshold: None,
             cut_zone: CutZone::Anywhere,
             max_inverted_frames: 30,

@@ -15,9 +15,10 @@ use super::neo_hookean::{
 use super::release_schedule::release_checks;
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
+use super::sweep_plan::{SweepPlan, tet_groups};
 use super::tet_constraint::project_tet;
 use super::tet_slot::TetSlot;
-use super::{CpuKernel, FrameStats, SolverError, SolverParams};
+use super::{CpuKernel, CpuSweep, FrameStats, SolverError, SolverParams};
 use crate::contact::{ContactTool, CutZone, ToolMotion, ToolPose, project_node};
 use crate::cutting::{CutState, ReleaseEvent};
 use crate::grab::Grab;
@@ -62,6 +63,8 @@ pub struct Solver {
     pub(crate) grabs: Vec<Grab>,
     pub(crate) slots: Vec<TetSlot>,
     pub(crate) color_ranges: Vec<std::ops::Range<usize>>,
+    /// The slots of each slab and cut per colour, for the partitioned sweep.
+    pub(crate) plan: SweepPlan,
     pub(crate) slot_of_tet: Vec<u32>,
     pub(crate) tet_of_slot: Vec<u32>,
     pub(crate) lambda_h: Vec<f32>,
@@ -85,6 +88,8 @@ pub struct Solver {
     pub(crate) time: f64,
     /// Wall time of the release checks inside the last frame's substeps, ms.
     pub(crate) check_ms: f64,
+    /// Parallel passes of the last frame (colours per substep, stress passes).
+    pub(crate) passes: u32,
     pub(crate) pool: Option<rayon::ThreadPool>,
 }
 
@@ -100,8 +105,15 @@ impl Solver {
         params.check_material(&material)?;
         let lame = material.lame();
         let (colors, ncolors) = greedy_tet_colors(mesh.node_count(), &mesh.tets);
+        // Colour first (the coloured sweep and the GPU), then the sweep plan's group.
+        let groups = tet_groups(&mesh.rest_positions, &mesh.tets);
         let mut order: Vec<u32> = (0..mesh.tet_count() as u32).collect();
-        order.sort_by_key(|&t| (colors[t as usize], t));
+        order.sort_by_key(|&t| (colors[t as usize], groups[t as usize], t));
+        let keys: Vec<(u32, u32)> = order
+            .iter()
+            .map(|&t| (colors[t as usize], groups[t as usize]))
+            .collect();
+        let plan = SweepPlan::new(&keys, ncolors);
         let mut color_ranges = Vec::with_capacity(ncolors);
         let mut begin = 0;
         for c in 0..ncolors as u32 {
@@ -158,6 +170,7 @@ impl Solver {
             grabs: Vec::new(),
             slots: Vec::new(),
             color_ranges,
+            plan,
             slot_of_tet,
             tet_of_slot: order.clone(),
             lambda_h: vec![0.0; t],
@@ -174,6 +187,7 @@ impl Solver {
             frame: 0,
             time: 0.0,
             check_ms: 0.0,
+            passes: 0,
             pool,
             lame,
             params,
@@ -307,6 +321,18 @@ impl Solver {
     /// Number of tet colours (parallel passes per substep).
     pub fn color_count(&self) -> usize {
         self.color_ranges.len()
+    }
+
+    /// Mesh tet of each slot: the order the solver and the GPU keep per-tet data in
+    /// (colour, then the partitioned sweep's group, then mesh index).
+    pub fn slot_tets(&self) -> &[u32] {
+        &self.tet_of_slot
+    }
+
+    /// Tets in each phase of the partitioned sweep: the slab blocks, the even cuts, the odd
+    /// cuts and the tets across more than two slabs (`CpuSweep::Blocks`).
+    pub fn sweep_phase_sizes(&self) -> Vec<usize> {
+        self.plan.phase_sizes()
     }
 
     /// Frames stepped so far.
@@ -472,11 +498,21 @@ impl Solver {
         let mut next = checks.iter().peekable();
         let mut fresh = false;
         self.check_ms = 0.0;
+        let per_sweep = match self.params.cpu_sweep {
+            CpuSweep::Coloured => self.color_ranges.len(),
+            CpuSweep::Blocks => self.plan.phases.len(),
+        };
+        self.passes = n * per_sweep as u32 + checks.len() as u32;
         for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
-            for c in 0..self.color_ranges.len() {
-                self.project_color(c, parallel);
+            match self.params.cpu_sweep {
+                CpuSweep::Coloured => {
+                    for c in 0..self.color_ranges.len() {
+                        self.project_color(c, parallel);
+                    }
+                }
+                CpuSweep::Blocks => self.project_blocks(parallel),
             }
             self.project_contacts(s, n);
             self.update_velocities(h);
@@ -547,39 +583,12 @@ impl Solver {
     /// Project every live tet of colour `c` (no two share a node).
     fn project_color(&mut self, c: usize, parallel: bool) {
         let range = self.color_ranges[c].clone();
-        let mode = self.params.projection;
-        let pair = self.params.constraints;
+        let projector = RunProjector::of(&self.params, &self.inv_mass);
         let nodes = SharedNodes::new(&mut self.u);
-        let inv_mass = &self.inv_mass;
-        let work = |slot: &TetSlot, lambda: &mut f32| {
-            if !slot.live {
-                return;
-            }
-            let idx = slot.nodes;
-            // SAFETY: tets of one colour share no node, so this tet's nodes are touched by
-            // this task only during the pass.
-            let mut p = idx.map(|i| unsafe { nodes.get(i) });
-            let w = idx.map(|i| inv_mass[i as usize]);
-            *lambda = project_tet(&mut p, &w, &slot.terms, mode, pair);
-            for k in 0..4 {
-                // SAFETY: as above.
-                unsafe { nodes.set(idx[k], p[k]) };
-            }
-        };
         let slots = &self.slots[range.clone()];
         let lambdas = &mut self.lambda_h[range];
-        let lanes = match self.params.cpu_kernel {
-            CpuKernel::Lanes => Some(true),
-            CpuKernel::PortableLanes => Some(false),
-            CpuKernel::Scalar => None,
-        }
-        .filter(|_| pair == ConstraintPair::RestFree && mode == TetProjection::Coupled);
-        // One run of consecutive slots: eight at a time in SIMD lanes, else one by one.
-        let run = |(s, l): (&[TetSlot], &mut [f32])| match lanes {
-            // SAFETY: tets of one colour share no node, and each run is one task's.
-            Some(detect) => unsafe { lane_pass::project_run(s, l, &nodes, inv_mass, detect) },
-            None => s.iter().zip(l).for_each(|(s, l)| work(s, l)),
-        };
+        // SAFETY: tets of one colour share no node, and each run is one task's.
+        let run = |(s, l): (&[TetSlot], &mut [f32])| unsafe { projector.run(s, l, &nodes) };
         if parallel && slots.len() > CHUNK {
             slots
                 .par_chunks(CHUNK)
@@ -587,6 +596,33 @@ impl Solver {
                 .for_each(run);
         } else {
             run((slots, lambdas));
+        }
+    }
+
+    /// One sweep in the partitioned order (`xpbd/sweep_plan.rs`): phase after phase, the
+    /// phase's groups in parallel, each group's tets colour after colour.
+    fn project_blocks(&mut self, parallel: bool) {
+        let projector = RunProjector::of(&self.params, &self.inv_mass);
+        let nodes = SharedNodes::new(&mut self.u);
+        let lambdas = SharedLambdas(self.lambda_h.as_mut_ptr());
+        let (slots, plan) = (&self.slots, &self.plan);
+        let group = |g: &usize| {
+            for r in &plan.runs[*g] {
+                // SAFETY: the groups of one phase share no node (slabs and alternate
+                // cuts), each run's tets are of one colour, and runs are disjoint ranges
+                // of the multipliers.
+                unsafe {
+                    let l = std::slice::from_raw_parts_mut(lambdas.at(r.start), r.len());
+                    projector.run(&slots[r.clone()], l, &nodes);
+                }
+            }
+        };
+        for phase in &plan.phases {
+            if parallel {
+                phase.par_iter().for_each(group);
+            } else {
+                phase.iter().for_each(group);
+            }
         }
     }
 
@@ -609,6 +645,7 @@ impl Solver {
     fn update_stress_and_check(&mut self, parallel: bool, fresh: bool) -> Result<(), SolverError> {
         self.check_finite()?;
         if !fresh {
+            self.passes += 1;
             self.compute_stress(parallel);
         }
         self.check_inversion()
@@ -783,6 +820,71 @@ impl Solver {
             solve_ms: 0.0,
             check_ms: 0.0,
             stress_ms: 0.0,
+            passes: self.passes,
+        }
+    }
+}
+
+/// The volume multipliers written by the tasks of the partitioned sweep.
+struct SharedLambdas(*mut f32);
+
+// SAFETY: each task writes only its own runs' disjoint ranges (`Solver::project_blocks`).
+unsafe impl Sync for SharedLambdas {}
+
+impl SharedLambdas {
+    /// The multiplier of slot `s`.
+    fn at(&self, s: usize) -> *mut f32 {
+        // SAFETY: `s` is a slot index, inside the array (the caller's runs).
+        unsafe { self.0.add(s) }
+    }
+}
+
+/// Projects runs of one colour's tets with the solver's kernel and constraint pair.
+struct RunProjector<'a> {
+    inv_mass: &'a [f32],
+    lanes: Option<bool>,
+    mode: TetProjection,
+    pair: ConstraintPair,
+}
+
+impl<'a> RunProjector<'a> {
+    /// The projector of `params`' kernel and pair: eight tets at a time in SIMD lanes (with
+    /// run-time AVX2 detection or not), or one by one.
+    fn of(params: &SolverParams, inv_mass: &'a [f32]) -> Self {
+        let (mode, pair) = (params.projection, params.constraints);
+        let lanes = match params.cpu_kernel {
+            CpuKernel::Lanes => Some(true),
+            CpuKernel::PortableLanes => Some(false),
+            CpuKernel::Scalar => None,
+        }
+        .filter(|_| pair == ConstraintPair::RestFree && mode == TetProjection::Coupled);
+        RunProjector {
+            inv_mass,
+            lanes,
+            mode,
+            pair,
+        }
+    }
+
+    /// Project `slots` (one colour's, sharing no node) and store their volume multipliers.
+    ///
+    /// # Safety
+    /// No other thread may touch these tets' nodes during the call.
+    unsafe fn run(&self, slots: &[TetSlot], lambdas: &mut [f32], nodes: &SharedNodes) {
+        if let Some(detect) = self.lanes {
+            // SAFETY: the caller's contract.
+            return unsafe { lane_pass::project_run(slots, lambdas, nodes, self.inv_mass, detect) };
+        }
+        for (slot, lambda) in slots.iter().zip(lambdas).filter(|(s, _)| s.live) {
+            let idx = slot.nodes;
+            // SAFETY: the caller's contract.
+            let mut p = idx.map(|i| unsafe { nodes.get(i) });
+            let w = idx.map(|i| self.inv_mass[i as usize]);
+            *lambda = project_tet(&mut p, &w, &slot.terms, self.mode, self.pair);
+            for k in 0..4 {
+                // SAFETY: as above.
+                unsafe { nodes.set(idx[k], p[k]) };
+            }
         }
     }
 }
