@@ -325,8 +325,9 @@ fn bench_render_honours_case_and_device() {
     assert_eq!(gpu["positions_from"], "gpu");
 }
 
-/// `incise experiment substeps` (issue 17, item 2): the bound, the scene's count and the
-/// reference, in that order, with the reference's own errors zero and the bound's not; and
+/// `incise experiment substeps` (issue 17, item 2; issue 31, item 2): the bound, the
+/// scene's count and the reference (≥ 375 substeps), in that order, with the reference's
+/// own errors zero and the bound's not, the released tets and first release of each run;
 /// `--update` rewrites the table between its markers in a document.
 #[test]
 fn experiment_substeps_compares_the_budget_with_the_reference() {
@@ -353,25 +354,74 @@ fn experiment_substeps_compares_the_budget_with_the_reference() {
         .filter(|l| l.starts_with("| config/"))
         .map(|l| l.split('|').map(|c| c.trim().to_string()).collect())
         .collect();
-    let roles: Vec<&str> = rows.iter().map(|r| r[3].as_str()).collect();
+    let roles: Vec<&str> = rows.iter().map(|r| r[4].as_str()).collect();
     assert_eq!(roles, ["bound", "scene", "reference"], "{table}");
     let num = |r: &[String], c: usize| r[c].trim_end_matches(" %").parse::<f64>().unwrap();
-    let substeps: Vec<f64> = rows.iter().map(|r| num(r, 2)).collect();
+    assert!(rows.iter().all(|r| r[2] == "3"), "frames: {table}");
+    let substeps: Vec<f64> = rows.iter().map(|r| num(r, 3)).collect();
     assert!(
-        substeps[0] < substeps[1] && substeps[2] >= 200.0,
+        substeps[0] < substeps[1] && substeps[2] >= 375.0,
         "{substeps:?}"
     );
-    assert_eq!((num(&rows[2], 4), num(&rows[2], 5)), (0.0, 0.0), "{table}");
-    assert!(num(&rows[0], 4) > 0.0 && num(&rows[0], 5) > 0.0, "{table}");
+    assert_eq!((num(&rows[2], 5), num(&rows[2], 6)), (0.0, 0.0), "{table}");
+    assert!(num(&rows[0], 5) > 0.0 && num(&rows[0], 6) > 0.0, "{table}");
+    // Three frames: the blade has not cut yet, and the tissue has moved.
+    assert!(rows.iter().all(|r| r[7] == "0" && r[8] == "–"), "{table}");
+    assert!(rows.iter().all(|r| num(r, 9) > 0.0), "{table}");
     let updated = std::fs::read_to_string(&doc).unwrap();
     assert!(
         updated.starts_with("before\n") && updated.ends_with("after\n"),
         "{updated}"
     );
     assert!(
-        !updated.contains("old") && updated.contains("| config/plate_cut.ron | 200 | reference |"),
+        !updated.contains("old")
+            && updated.contains("| config/plate_cut.ron | 3 | 375 | reference |"),
         "{updated}"
     );
+}
+
+/// Without `--frames` a scene runs its whole duration, and a converged row needs the
+/// reference's tear: the same released tets and first release (issue 31, item 2).
+#[test]
+fn experiment_substeps_runs_the_whole_scene_and_judges_the_tear() {
+    let dir = temp_dir("exp-substeps-tear");
+    let scene = dir.join("tear.ron");
+    // The plate stretch, shortened to 1 s: it tears within it.
+    let text_of = std::fs::read_to_string("config/plate_stretch.ron").unwrap();
+    let short = with_duration(&text_of, "1.0");
+    std::fs::write(&scene, short).unwrap();
+    std::fs::copy("config/materials.ron", dir.join("materials.ron")).unwrap();
+    let o = incise(&["experiment", "substeps", scene.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let table = text(&o.stdout);
+    let rows: Vec<Vec<String>> = table
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.contains("tear.ron"))
+        .map(|l| l.split('|').map(|c| c.trim().to_string()).collect())
+        .collect();
+    assert_eq!(rows.len(), 3, "{table}");
+    assert!(rows.iter().all(|r| r[2] == "60"), "1 s at 60 Hz: {table}");
+    let reference = &rows[2];
+    let released: usize = reference[7].parse().unwrap();
+    assert!(released > 0, "the reference tears: {table}");
+    assert_ne!(reference[8], "–", "{table}");
+    assert_eq!(reference[11], "yes", "{table}");
+    for r in &rows[..2] {
+        let n: usize = r[7].parse().unwrap();
+        let converged = r[11] == "yes";
+        let within = n.abs_diff(released) as f64 <= 0.1 * released as f64;
+        assert!(
+            !converged || within,
+            "converged with {n} released against {released}: {table}"
+        );
+    }
+}
+
+/// `text` with its `duration: …` replaced by `seconds`.
+fn with_duration(text: &str, seconds: &str) -> String {
+    let at = text.find("duration:").expect("a duration");
+    let end = at + text[at..].find(',').unwrap();
+    format!("{}duration: {seconds}{}", &text[..at], &text[end..])
 }
 
 /// Run `incise experiment NAME --quick` into a scratch folder; what it printed must be

@@ -1,11 +1,13 @@
-//! `incise experiment substeps`: the substep budget of each XPBD scene (issue 17, item 2).
-//! Each scene runs as scripted (grabs, the scalpel's stroke, cutting) at the fewest
-//! substeps the stability bound allows, at the scene's own count, and at a reference count
-//! (≥ 200 and ≥ 3× the scene's); the table compares the end state with the reference: the
-//! von Mises field over the tets live in both, the displacement field, the released tets
-//! and the volume error `mean |J − 1|`. A run the solver stops (an inverted tet) is a row
-//! that says so. `--update FILE` rewrites the table between its markers
-//! (docs/physics-notes.md).
+//! `incise experiment substeps`: the substep budget of each XPBD scene (issue 17, item 2)
+//! and whether a scene's own budget is converged (issue 31, item 2). Each scene runs as
+//! scripted (grabs, the scalpel's stroke, cutting) over its whole duration (or
+//! `--frames`) at the fewest substeps the stability bound allows, at the scene's own
+//! count, and at a reference count (≥ [`REFERENCE_SUBSTEPS`] and ≥ 3× the scene's); the
+//! table compares the end state with the reference: the von Mises field over the tets
+//! live in both, the displacement field, the released tets and the frame of the first
+//! release, the largest displacement (a cantilever's tip sag) and the volume error
+//! `mean |J − 1|`. A run the solver stops (an inverted tet) is a row that says so.
+//! `--update FILE` rewrites the table between its markers (docs/physics-notes.md).
 
 use std::path::{Path, PathBuf};
 
@@ -24,6 +26,16 @@ pub const END: &str = "<!-- /substep-budget -->";
 /// Largest relative field error (stress and displacement) still called converged.
 pub const CONVERGED: f64 = 0.05;
 
+/// Largest relative difference of the released tets from the reference still called
+/// converged (issue 31's target).
+pub const RELEASED_WITHIN: f64 = 0.10;
+
+/// Most frames the first release may lie from the reference's and be called converged.
+pub const FIRST_RELEASE_WITHIN: u64 = 2;
+
+/// The fewest substeps of the reference run.
+pub const REFERENCE_SUBSTEPS: u32 = 375;
+
 /// The end state of one run.
 #[derive(Clone)]
 struct EndState {
@@ -32,6 +44,8 @@ struct EndState {
     live: Vec<bool>,
     volume_error: f64,
     ms_per_frame: f64,
+    first_release: Option<u64>,
+    max_displacement: f64,
 }
 
 /// One run compared with the reference.
@@ -49,6 +63,16 @@ pub struct BudgetRow {
     pub displacement_error: f64,
     /// Released tets at the end.
     pub released: usize,
+    /// Released tets at the end of the reference run.
+    pub reference_released: usize,
+    /// Frame of the first release (`None`: nothing released).
+    pub first_release: Option<u64>,
+    /// The reference's frame of the first release.
+    pub reference_first_release: Option<u64>,
+    /// Largest node displacement at the end, m (a cantilever's tip sag).
+    pub max_displacement: f64,
+    /// Frames run.
+    pub frames: u32,
     /// `mean |J − 1|` over the live tets.
     pub volume_error: f64,
     /// Wall ms per frame of this run (machine-dependent).
@@ -58,12 +82,28 @@ pub struct BudgetRow {
 }
 
 impl BudgetRow {
-    /// Whether both field errors are within [`CONVERGED`].
+    /// Whether both field errors are within [`CONVERGED`], the released tets within
+    /// [`RELEASED_WITHIN`] of the reference's and the first release within
+    /// [`FIRST_RELEASE_WITHIN`] frames of it.
     pub fn converged(&self) -> bool {
+        let released = self.released.abs_diff(self.reference_released) as f64
+            <= RELEASED_WITHIN * self.reference_released as f64;
+        let first = match (self.first_release, self.reference_first_release) {
+            (Some(a), Some(b)) => a.abs_diff(b) <= FIRST_RELEASE_WITHIN,
+            (a, b) => a == b,
+        };
         self.failure.is_none()
             && self.stress_error <= CONVERGED
             && self.displacement_error <= CONVERGED
+            && released
+            && first
     }
+}
+
+/// Frames of `scene_path`'s whole duration at its frame length.
+fn scene_frames(scene_path: &Path) -> Result<u32> {
+    let scene = load_scene(scene_path)?;
+    Ok((scene.duration as f64 / scene.solver.frame_dt as f64 - 1e-6).ceil() as u32)
 }
 
 /// Run `scene` for `frames` frames at `substeps`.
@@ -76,18 +116,26 @@ fn run_at(scene_path: &Path, substeps: u32, frames: u32) -> Result<EndState> {
     let stroke = built.tool.and_then(|t| t.stroke);
     let dt = solver.params().frame_dt as f64;
     let t0 = std::time::Instant::now();
+    let mut first_release = None;
     for f in 0..frames {
         if let Some(s) = &stroke {
             solver.move_tool(s.pose_at((f + 1) as f64 * dt));
         }
-        solver
+        let st = solver
             .step_frame()
             .with_context(|| format!("{}: {substeps} substeps, frame {f}", scene_path.display()))?;
+        if st.released_now > 0 && first_release.is_none() {
+            first_release = Some(f as u64);
+        }
     }
     let ms_per_frame = t0.elapsed().as_secs_f64() * 1e3 / frames.max(1) as f64;
-    Ok(end_state(&solver, ms_per_frame))
+    Ok(EndState {
+        first_release,
+        ..end_state(&solver, ms_per_frame)
+    })
 }
 
+/// The state `s` ends in (no release seen: the caller fills `first_release`).
 fn end_state(s: &Solver, ms_per_frame: f64) -> EndState {
     let live: Vec<bool> = (0..s.mesh().tet_count())
         .map(|t| s.cut().is_live(t))
@@ -105,6 +153,13 @@ fn end_state(s: &Solver, ms_per_frame: f64) -> EndState {
         volume_error: j.iter().sum::<f64>() / j.len().max(1) as f64,
         live,
         ms_per_frame,
+        first_release: None,
+        max_displacement: s
+            .positions()
+            .iter()
+            .zip(&s.mesh().rest_positions)
+            .map(|(x, r)| (*x - *r).length() as f64)
+            .fold(0.0, f64::max),
     }
 }
 
@@ -137,7 +192,7 @@ fn displacement_error(x: &[Vec3], reference: &[Vec3], rest: &[Vec3]) -> f64 {
 
 /// The row of one run (`Err`: the run stopped).
 fn row(
-    scene: &Path,
+    (scene, frames): (&Path, u32),
     (substeps, role): (u32, &'static str),
     run: Result<EndState>,
     reference: &EndState,
@@ -150,6 +205,11 @@ fn row(
         stress_error: f64::NAN,
         displacement_error: f64::NAN,
         released: 0,
+        reference_released: reference.live.iter().filter(|l| !**l).count(),
+        first_release: None,
+        reference_first_release: reference.first_release,
+        max_displacement: f64::NAN,
+        frames,
         volume_error: f64::NAN,
         ms_per_frame: f64::NAN,
         failure: None,
@@ -159,6 +219,8 @@ fn row(
             stress_error: stress_error(&st, reference),
             displacement_error: displacement_error(&st.x, &reference.x, rest),
             released: st.live.iter().filter(|l| !**l).count(),
+            first_release: st.first_release,
+            max_displacement: st.max_displacement,
             volume_error: st.volume_error,
             ms_per_frame: st.ms_per_frame,
             ..base
@@ -181,10 +243,15 @@ fn bound_substeps(scene_path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
     ))
 }
 
-/// The rows of one scene: the bound, the scene's count and the reference.
-pub fn measure(scene_path: &Path, frames: u32) -> Result<Vec<BudgetRow>> {
+/// The rows of one scene: the bound, the scene's count and the reference, over `frames`
+/// frames (`None`: the scene's whole duration).
+pub fn measure(scene_path: &Path, frames: Option<u32>) -> Result<Vec<BudgetRow>> {
     let (bound, own, rest) = bound_substeps(scene_path)?;
-    let reference = 200.max(3 * own);
+    let frames = match frames {
+        Some(f) => f,
+        None => scene_frames(scene_path)?,
+    };
+    let reference = REFERENCE_SUBSTEPS.max(3 * own);
     let ref_state = run_at(scene_path, reference, frames)
         .with_context(|| format!("{}: the reference run", scene_path.display()))?;
     let mut counts = vec![(
@@ -202,7 +269,7 @@ pub fn measure(scene_path: &Path, frames: u32) -> Result<Vec<BudgetRow>> {
         .into_iter()
         .map(|c| {
             row(
-                scene_path,
+                (scene_path, frames),
                 c,
                 run_at(scene_path, c.0, frames),
                 &ref_state,
@@ -212,7 +279,7 @@ pub fn measure(scene_path: &Path, frames: u32) -> Result<Vec<BudgetRow>> {
         .collect();
     let own_ref = Ok(ref_state.clone());
     rows.push(row(
-        scene_path,
+        (scene_path, frames),
         (reference, "reference"),
         own_ref,
         &ref_state,
@@ -222,13 +289,17 @@ pub fn measure(scene_path: &Path, frames: u32) -> Result<Vec<BudgetRow>> {
 }
 
 /// The rows as a markdown table (between [`BEGIN`] and [`END`]).
-pub fn markdown(rows: &[BudgetRow], frames: u32) -> String {
+pub fn markdown(rows: &[BudgetRow]) -> String {
     let mut s = format!(
-        "{BEGIN}\n\n{frames} frames per run, as scripted (cutting on). Errors against the \
-         reference run (stress over the tets live in both); converged: both ≤ {:.0} %.\n\n\
-         | scene | substeps | which | σvM field error | displacement error | released tets | mean \\|J − 1\\| | converged | ms/frame |\n\
-         |---|---:|---|---:|---:|---:|---:|---|---:|\n",
-        CONVERGED * 100.0
+        "{BEGIN}\n\nEach run as scripted (cutting on) for the frames given. Errors against the \
+         reference run (stress over the tets live in both); converged: both ≤ {:.0} %, the \
+         released tets within {:.0} % of the reference's and the first release within {} \
+         frames of it.\n\n\
+         | scene | frames | substeps | which | σvM field error | displacement error | released tets | first release (frame) | max \\|u\\| mm | mean \\|J − 1\\| | converged | ms/frame |\n\
+         |---|---:|---:|---|---:|---:|---:|---:|---:|---:|---|---:|\n",
+        CONVERGED * 100.0,
+        RELEASED_WITHIN * 100.0,
+        FIRST_RELEASE_WITHIN,
     );
     for r in rows {
         s += &table_row(r);
@@ -239,31 +310,35 @@ pub fn markdown(rows: &[BudgetRow], frames: u32) -> String {
 fn table_row(r: &BudgetRow) -> String {
     if let Some(why) = &r.failure {
         return format!(
-            "| {} | {} | {} | – | – | – | – | no: {why} | – |\n",
-            r.scene, r.substeps, r.role
+            "| {} | {} | {} | {} | – | – | – | – | – | – | no: {why} | – |\n",
+            r.scene, r.frames, r.substeps, r.role
         );
     }
     format!(
-        "| {} | {} | {} | {:.2} % | {:.2} % | {} | {:.2e} | {} | {:.1} |\n",
+        "| {} | {} | {} | {} | {:.2} % | {:.2} % | {} | {} | {:.2} | {:.2e} | {} | {:.1} |\n",
         r.scene,
+        r.frames,
         r.substeps,
         r.role,
         r.stress_error * 100.0,
         r.displacement_error * 100.0,
         r.released,
+        r.first_release.map_or("–".into(), |f| f.to_string()),
+        r.max_displacement * 1e3,
         r.volume_error,
         if r.converged() { "yes" } else { "no" },
         r.ms_per_frame
     )
 }
 
-/// Measure `scenes` and print (or, with `update_file`, also rewrite) the table.
-pub fn run(scenes: &[PathBuf], frames: u32, update_file: Option<&Path>) -> Result<String> {
+/// Measure `scenes` over `frames` frames each (`None`: each scene's whole duration) and
+/// print (or, with `update_file`, also rewrite) the table.
+pub fn run(scenes: &[PathBuf], frames: Option<u32>, update_file: Option<&Path>) -> Result<String> {
     let mut rows = Vec::new();
     for s in scenes {
         rows.extend(measure(s, frames)?);
     }
-    let table = markdown(&rows, frames);
+    let table = markdown(&rows);
     if let Some(file) = update_file {
         super::doc_table::replace_between(file, "substep-budget", (BEGIN, END), &table)?;
     }
