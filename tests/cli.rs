@@ -312,6 +312,9 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
         assert!(one > 0.0 && all > 0.0, "{row}");
         assert!((scaling - one / all).abs() < 0.01 + 0.01 * scaling, "{row}");
         assert!(cells[10].parse::<f64>().unwrap() > 0.0, "GFLOP/s: {row}");
+        // The frame in fine sweeps: at least its substeps' worth.
+        let sweeps: f64 = cells[15].parse().unwrap();
+        assert!(sweeps >= 0.5 * 24.0, "fine sweeps a frame: {row}");
     }
     assert!(
         out.contains("Flops of a sweep: ") && out.contains(" per tet projection"),

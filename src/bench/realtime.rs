@@ -161,15 +161,21 @@ fn median_of(rs: &[RealtimeResult], f: impl Fn(&RealtimeResult) -> f64) -> f64 {
 
 /// The runs of each kernel as docs/performance.md's realtime table: min and median over
 /// the runs of each run's median frame; the sweep on one thread and on all, their ratio,
-/// GFLOP/s and the share of the machine's peak on all threads; then how the peak and the
+/// GFLOP/s and the share of the machine's peak on all threads; the frame's cost in fine
+/// sweeps (its median ms over the ms of one coloured `Lanes` XPBD sweep of the same mesh on
+/// all threads, measured in the same run: issue 31's yardstick); then how the peak and the
 /// flops were counted.
 pub fn markdown(runs: &[KernelRuns]) -> String {
     let mut s = format!(
-        "{}\n\n| scene | device | tets | substeps / frame | kernel | ms/frame min / median | fps (median) | ms per sweep, 1 thread / all | 1 → all threads | GFLOP/s | % of peak | passes / frame | release checks ms | stress + guards ms |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "{}\n\n| scene | device | tets | substeps / frame | kernel | ms/frame min / median | fps (median) | ms per sweep, 1 thread / all | 1 → all threads | GFLOP/s | % of peak | passes / frame | release checks ms | stress + guards ms | fine sweeps / frame |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         crate::provenance::generated_by()
     );
     let mut peak = None;
+    let unit = runs
+        .iter()
+        .find(|k| k.all.first().is_some_and(|r| r.cpu_kernel == "Lanes"))
+        .map(|k| median_of(&k.all, |r| r.sweep_ms_median));
     for k in runs.iter().filter(|k| !k.all.is_empty()) {
         let rs = &k.all;
         let median = median_of(rs, |r| r.frame_ms_median);
@@ -194,7 +200,7 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
             format!("{:.1} %", 100.0 * gflops / p.gflops)
         });
         s += &format!(
-            "| {} | {} | {} | {} | {} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep:.3} | {scaling} | {gflops:.2} | {share} | {} | {:.1} | {:.2} |\n",
+            "| {} | {} | {} | {} | {} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep:.3} | {scaling} | {gflops:.2} | {share} | {} | {:.1} | {:.2} | {:.1} |\n",
             r.scene,
             r.device,
             r.tets,
@@ -204,6 +210,7 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
             median_of(rs, |r| r.passes_per_frame as f64),
             median_of(rs, |r| r.release_checks_ms_median),
             median_of(rs, |r| r.stress_ms_median),
+            median / unit.unwrap_or(sweep),
         );
     }
     s += &format!(
