@@ -11,27 +11,35 @@ use std::path::Path;
 /// A module path: `["xr", "frame_loop"]` for `src/xr/frame_loop.rs`; `[]` for lib.rs.
 type Module = Vec<String>;
 
-/// Every `.rs` file under `root` by module path, with its source.
-fn modules(root: &Path) -> BTreeMap<Module, String> {
-    let mut out = BTreeMap::new();
+/// Every file under `root` whose name ends in `.ext`, leaving out hidden folders and
+/// `target`.
+fn files_under(root: &Path, ext: &str) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
     let mut dirs = vec![root.to_path_buf()];
     while let Some(dir) = dirs.pop() {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
-            if path.is_dir() {
+            let name = path.file_name().unwrap().to_string_lossy();
+            if path.is_dir() && !name.starts_with('.') && name != "target" {
                 dirs.push(path);
-                continue;
+            } else if path.extension().is_some_and(|e| e == ext) {
+                out.push(path);
             }
-            if path.extension().is_none_or(|e| e != "rs") {
-                continue;
-            }
-            let rel = path.strip_prefix(root).unwrap().with_extension("");
-            let mut m: Module = rel.iter().map(|c| c.to_string_lossy().into()).collect();
-            if matches!(m.last().map(String::as_str), Some("mod" | "lib" | "main")) {
-                m.pop();
-            }
-            out.insert(m, std::fs::read_to_string(&path).unwrap());
         }
+    }
+    out
+}
+
+/// Every `.rs` file under `root` by module path, with its source.
+fn modules(root: &Path) -> BTreeMap<Module, String> {
+    let mut out = BTreeMap::new();
+    for path in files_under(root, "rs") {
+        let rel = path.strip_prefix(root).unwrap().with_extension("");
+        let mut m: Module = rel.iter().map(|c| c.to_string_lossy().into()).collect();
+        if matches!(m.last().map(String::as_str), Some("mod" | "lib" | "main")) {
+            m.pop();
+        }
+        out.insert(m, std::fs::read_to_string(&path).unwrap());
     }
     out
 }
@@ -196,41 +204,20 @@ fn a_circle_of_imports_is_found() {
 /// file, included file) with the included path resolved against the including file.
 fn includes(src: &Path) -> Vec<(std::path::PathBuf, std::path::PathBuf)> {
     let mut out = Vec::new();
-    let mut dirs = vec![src.to_path_buf()];
-    while let Some(dir) = dirs.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                dirs.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                let text = std::fs::read_to_string(&path).unwrap();
-                for part in text.split("include_").skip(1) {
-                    let Some(rest) = part
-                        .strip_prefix("str!(\"")
-                        .or_else(|| part.strip_prefix("bytes!(\""))
-                    else {
-                        continue;
-                    };
-                    let name = &rest[..rest.find('"').unwrap()];
-                    out.push((path.clone(), path.parent().unwrap().join(name)));
-                }
-            }
+    for path in files_under(src, "rs") {
+        let text = std::fs::read_to_string(&path).unwrap();
+        for part in text.split("include_").skip(1) {
+            let Some(rest) = part
+                .strip_prefix("str!(\"")
+                .or_else(|| part.strip_prefix("bytes!(\""))
+            else {
+                continue;
+            };
+            let name = &rest[..rest.find('"').unwrap()];
+            out.push((path.clone(), path.parent().unwrap().join(name)));
         }
     }
     out
-}
-
-/// Every `.wgsl` file under `dir`.
-fn wgsl_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        let name = path.file_name().unwrap().to_string_lossy();
-        if path.is_dir() && !name.starts_with('.') && name != "target" {
-            wgsl_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "wgsl") {
-            out.push(path);
-        }
-    }
 }
 
 /// Each crate stands alone: what it compiles in (`include_str!`, `include_bytes!`) lies
@@ -257,8 +244,7 @@ fn each_crate_compiles_in_only_its_own_files_and_every_shader_is_used() {
             used.insert(file);
         }
     }
-    let mut shaders = Vec::new();
-    wgsl_files(&root, &mut shaders);
+    let shaders = files_under(&root, "wgsl");
     assert!(
         shaders.len() >= 18,
         "only {} WGSL files found",

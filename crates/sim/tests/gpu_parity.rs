@@ -7,18 +7,10 @@
 
 mod common;
 
-use common::{block_mesh, soft, solver};
+use common::{block_mesh, soft, solver, worst_gap};
 use glam::{UVec3, Vec3};
 use incise_sim::SolverParams;
 use incise_sim::gpu::GpuSolver;
-
-/// Largest distance between matching nodes of two position sets, m.
-fn worst_gap(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| (*p - *q).length())
-        .fold(0.0, f32::max)
-}
 
 #[test]
 fn gpu_matches_cpu_on_a_tearing_bar() {

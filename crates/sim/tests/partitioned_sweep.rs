@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{block_mesh, soft};
+use common::{block_mesh, soft, worst_gap};
 use glam::{UVec3, Vec3};
 use incise_sim::grab::Grab;
 use incise_sim::selection::NodeSelection;
@@ -53,14 +53,6 @@ fn run(mut s: Solver, frames: usize) -> (Vec<Vec<Vec3>>, Vec<bool>) {
         })
         .collect();
     (xs, s.cut().live().to_vec())
-}
-
-/// Largest distance between matching nodes, m.
-fn worst_gap(a: &[Vec3], b: &[Vec3]) -> f32 {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| (*p - *q).length())
-        .fold(0.0, f32::max)
 }
 
 /// The slabs are fixed and the groups of a phase share no node, so 1, 2 and 3 threads

@@ -240,3 +240,11 @@ pub fn tool_targets(path: &[Vec3], speed: f32, dt: f32, hold: usize) -> Vec<Vec3
     }
     out
 }
+
+/// Largest distance between matching nodes of two position sets, m.
+pub fn worst_gap(a: &[Vec3], b: &[Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (*p - *q).length())
+        .fold(0.0, f32::max)
+}
