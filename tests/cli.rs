@@ -525,3 +525,72 @@ fn compare_finds_cpu_and_gpu_in_agreement() {
     assert!(c["released_cpu"].as_u64().unwrap() > 0);
     assert_eq!(c["released_mismatch"], 0);
 }
+
+/// Run `scene` for three frames on the CPU into `out`.
+fn run_three_frames(scene: &Path, out: &Path) -> std::process::Output {
+    incise(&[
+        "run",
+        scene.to_str().unwrap(),
+        "--frames",
+        "3",
+        "--vtu-every",
+        "0",
+        "--device",
+        "cpu",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
+/// A shipped scene copied into a folder of its own runs (issue 34, item 2): its material or
+/// rheology presets come from the built-in copies of config/'s preset files when none lies
+/// beside it, and the report says which file was read; a preset file beside the scene
+/// wins. A preset file that is neither there nor shipped is an error that names it and
+/// the OS's cause once.
+#[test]
+fn a_scene_copied_anywhere_runs_with_the_built_in_presets() {
+    let dir = temp_dir("scene-anywhere");
+    for name in ["plate_stretch.ron", "organ_layers.ron"] {
+        let scene = dir.join(name);
+        std::fs::copy(Path::new("config").join(name), &scene).unwrap();
+        let o = run_three_frames(&scene, &dir.join(format!("out-{name}")));
+        assert!(o.status.success(), "{name}: {}", text(&o.stderr));
+        assert!(
+            !text(&o.stderr).contains("error"),
+            "{name}: {}",
+            text(&o.stderr)
+        );
+    }
+    let r: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(dir.join("out-organ_layers.ron/report.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        r["rheology"]["presets_file"], "built-in config/rheology.ron",
+        "{r}"
+    );
+    // A preset file beside the scene wins: an unusable one is refused, naming it.
+    std::fs::write(
+        dir.join("materials.ron"),
+        "{ \"skin\": (youngs_modulus: -1.0, poisson_ratio: 0.45, density: 1000.0) }",
+    )
+    .unwrap();
+    let o = run_three_frames(&dir.join("plate_stretch.ron"), &dir.join("out-local"));
+    assert!(!o.status.success());
+    assert!(
+        text(&o.stderr).contains(&format!("{}", dir.join("materials.ron").display())),
+        "{}",
+        text(&o.stderr)
+    );
+    // Neither beside the scene nor shipped: named once, with its cause once.
+    let own = std::fs::read_to_string("config/organ_layers.ron")
+        .unwrap()
+        .replace("presets: \"rheology.ron\"", "presets: \"mine.ron\"");
+    std::fs::write(dir.join("mine_layers.ron"), own).unwrap();
+    let o = run_three_frames(&dir.join("mine_layers.ron"), &dir.join("out-mine"));
+    let err = text(&o.stderr);
+    assert!(!o.status.success());
+    assert_eq!(err.matches("mine.ron").count(), 1, "{err}");
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+}

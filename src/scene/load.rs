@@ -126,12 +126,17 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
 
 /// Read `materials.ron`: a map from preset name to material, each validated.
 pub fn load_materials(path: &Path) -> Result<BTreeMap<String, Material>, SceneError> {
-    let text = ron_file::read(path)?;
-    let map: BTreeMap<String, Material> = ron_file::parse(&text, path)?;
+    parse_materials(&ron_file::read(path)?, path)
+}
+
+/// Parse the text of a `materials.ron` (`path` names it in errors), each material
+/// validated.
+pub fn parse_materials(text: &str, path: &Path) -> Result<BTreeMap<String, Material>, SceneError> {
+    let map: BTreeMap<String, Material> = ron_file::parse(text, path)?;
     for (name, m) in &map {
         m.validate().map_err(|e| SceneError::Value {
             path: path.into(),
-            line: field_line(&text, &format!("\"{name}\"")),
+            line: field_line(text, &format!("\"{name}\"")),
             field: name.clone(),
             msg: e.to_string(),
         })?;

@@ -1,12 +1,13 @@
 //! A scene's tissue material: its own values, or a preset of `materials.ron` beside the
-//! scene file.
+//! scene file (the built-in copy of the shipped one where there is none).
 
 use std::path::Path;
 
 use anyhow::{Result, anyhow};
 use incise_sim::Material;
 
-use super::{MaterialChoice, Scene, load_materials};
+use super::built_in::preset_text;
+use super::{MaterialChoice, Scene, parse_materials};
 
 /// The material of `scene` (read from `scene_path`) and its name ("custom" for values
 /// given in the scene); an error naming the file when it is missing or an unknown preset.
@@ -18,8 +19,8 @@ pub fn scene_material(scene: &Scene, scene_path: &Path) -> Result<(Material, Str
         }
         MaterialChoice::Custom(m) => (*m, "custom".to_string()),
         MaterialChoice::Preset(name) => {
-            let file = dir.join("materials.ron");
-            let presets = load_materials(&file)?;
+            let (file, text) = preset_text(dir, "materials.ron")?;
+            let presets = parse_materials(&text, &file)?;
             let m = presets.get(name).ok_or_else(|| {
                 anyhow!(
                     "{}: material preset \"{name}\" is not in {} (known: {})",

@@ -2,6 +2,7 @@
 //! grabs, solver settings, cutting, duration).
 
 mod build;
+pub mod built_in;
 pub mod hand_tool;
 mod load;
 mod localisation;
@@ -11,7 +12,7 @@ mod tool;
 
 pub use build::raw_mesh;
 pub use build::{BuiltScene, SceneTool, ToolDriver, build_scene, build_scene_driven};
-pub use load::{SceneError, load_materials, load_scene, locate, parse_scene};
+pub use load::{SceneError, load_materials, load_scene, locate, parse_materials, parse_scene};
 pub use localisation::Localisation;
 pub use material::scene_material;
 pub use model::{

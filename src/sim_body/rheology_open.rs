@@ -28,8 +28,9 @@ pub fn open(
     let (raw, _) = raw_mesh(&scene.mesh, dir)?;
     let (mesh, mesh_report) =
         TetMesh::from_raw(raw).with_context(|| format!("{}: mesh", path.display()))?;
-    let presets_path = dir.join(&rh.presets);
-    let presets = RheologyPresets::load(&presets_path)
+    let (presets_path, presets) = crate::scene::built_in::preset_text(dir, &rh.presets)
+        .map_err(anyhow::Error::from)
+        .and_then(|(file, text)| Ok((file.clone(), RheologyPresets::parse(&text, &file)?)))
         .with_context(|| format!("{}: model.presets", path.display()))?;
     let names = material_names(rh);
     let (materials, map) = materials(&mesh, rh, &presets, &names, path)?;

@@ -6,14 +6,15 @@ use std::path::{Path, PathBuf};
 
 use serde::de::DeserializeOwned;
 
-/// A file that could not be read: `file: OS error`.
+/// A file that could not be read: `file: OS error`. The OS error is part of the message,
+/// not a separate cause, so an error chain prints it once.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: {source}")]
+#[error("{path}: {error}")]
 pub struct ReadError {
     /// The file.
     pub path: PathBuf,
     /// OS error.
-    pub source: std::io::Error,
+    pub error: std::io::Error,
 }
 
 /// RON syntax, unknown field, wrong type: `file:line:col: message`, ron's position and
@@ -45,9 +46,9 @@ impl SyntaxError {
 
 /// Read the file `path` to a string, naming it on failure.
 pub fn read(path: &Path) -> Result<String, ReadError> {
-    std::fs::read_to_string(path).map_err(|source| ReadError {
+    std::fs::read_to_string(path).map_err(|error| ReadError {
         path: path.into(),
-        source,
+        error,
     })
 }
 
