@@ -355,19 +355,7 @@ fn every_shipped_scene_runs() {
     for scene in &scenes {
         let name = scene.file_stem().unwrap().to_str().unwrap();
         let out = dir.join(name);
-        let o = incise(&[
-            "run",
-            scene.to_str().unwrap(),
-            "--frames",
-            "3",
-            "--vtu-every",
-            "0",
-            "--device",
-            "cpu",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let o = run_three_frames(scene, &out);
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));
         let r: serde_json::Value =
             serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();

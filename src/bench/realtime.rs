@@ -171,7 +171,11 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         crate::provenance::generated_by()
     );
-    let mut peak = None;
+    // The peak of the threads the CPU rows ran on (none for the GPU).
+    let peak = runs
+        .iter()
+        .find_map(|k| k.all.first().filter(|r| r.threads > 0))
+        .and_then(|r| crate::bench::peak::peak(r.threads));
     let unit = runs
         .iter()
         .find(|k| k.all.first().is_some_and(|r| r.cpu_kernel == "Lanes"))
@@ -193,9 +197,6 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
                 (format!("{one:.3}"), format!("{:.2}×", one / sweep))
             }
         };
-        peak = (r.threads > 0)
-            .then(|| crate::bench::peak::peak(r.threads))
-            .flatten();
         let share = peak.as_ref().map_or("–".to_string(), |p| {
             format!("{:.1} %", 100.0 * gflops / p.gflops)
         });
@@ -245,7 +246,7 @@ pub fn measure(
         CpuSweep::Coloured => format!("{:?}", params.cpu_kernel),
         CpuSweep::Blocks => format!("{:?}, Blocks", params.cpu_kernel),
     };
-    let cpu_threads = match built.solver.params().threads {
+    let cpu_threads = match params.threads {
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
         n => n,
     };

@@ -100,12 +100,6 @@ impl BudgetRow {
     }
 }
 
-/// Frames of `scene_path`'s whole duration at its frame length.
-fn scene_frames(scene_path: &Path) -> Result<u32> {
-    let scene = load_scene(scene_path)?;
-    Ok((scene.duration as f64 / scene.solver.frame_dt as f64 - 1e-6).ceil() as u32)
-}
-
 /// Run `scene` for `frames` frames at `substeps`.
 fn run_at(scene_path: &Path, substeps: u32, frames: u32) -> Result<EndState> {
     let mut scene = load_scene(scene_path)?;
@@ -133,6 +127,13 @@ fn run_at(scene_path: &Path, substeps: u32, frames: u32) -> Result<EndState> {
         first_release,
         ..end_state(&solver, ms_per_frame)
     })
+}
+
+impl EndState {
+    /// Tets released by the end.
+    fn released(&self) -> usize {
+        self.live.iter().filter(|l| !**l).count()
+    }
 }
 
 /// The state `s` ends in (no release seen: the caller fills `first_release`).
@@ -205,7 +206,7 @@ fn row(
         stress_error: f64::NAN,
         displacement_error: f64::NAN,
         released: 0,
-        reference_released: reference.live.iter().filter(|l| !**l).count(),
+        reference_released: reference.released(),
         first_release: None,
         reference_first_release: reference.first_release,
         max_displacement: f64::NAN,
@@ -218,7 +219,7 @@ fn row(
         Ok(st) => BudgetRow {
             stress_error: stress_error(&st, reference),
             displacement_error: displacement_error(&st.x, &reference.x, rest),
-            released: st.live.iter().filter(|l| !**l).count(),
+            released: st.released(),
             first_release: st.first_release,
             max_displacement: st.max_displacement,
             volume_error: st.volume_error,
@@ -232,25 +233,40 @@ fn row(
     }
 }
 
-/// The fewest substeps the stability bound allows for `scene` (κ ≤ 1 at the worst tet).
-fn bound_substeps(scene_path: &Path) -> Result<(u32, u32, Vec<Vec3>)> {
+/// What a scene's runs start from.
+struct SceneBudget {
+    /// The fewest substeps the stability bound allows (κ ≤ 1 at the worst tet).
+    bound: u32,
+    /// The scene's own substeps.
+    own: u32,
+    /// Frames of the scene's whole duration.
+    frames: u32,
+    /// Rest positions.
+    rest: Vec<Vec3>,
+}
+
+/// The stability bound, own substeps, duration in frames and rest state of a scene.
+fn scene_budget(scene_path: &Path) -> Result<SceneBudget> {
     let scene = load_scene(scene_path)?;
     let s = build_scene(&scene, scene_path, None)?.solver;
-    Ok((
-        s.fewest_stable_substeps().max(1),
-        s.params().substeps,
-        s.mesh().rest_positions.clone(),
-    ))
+    Ok(SceneBudget {
+        bound: s.fewest_stable_substeps().max(1),
+        own: s.params().substeps,
+        frames: (scene.duration as f64 / s.params().frame_dt as f64 - 1e-6).ceil() as u32,
+        rest: s.mesh().rest_positions.clone(),
+    })
 }
 
 /// The rows of one scene: the bound, the scene's count and the reference, over `frames`
 /// frames (`None`: the scene's whole duration).
 pub fn measure(scene_path: &Path, frames: Option<u32>) -> Result<Vec<BudgetRow>> {
-    let (bound, own, rest) = bound_substeps(scene_path)?;
-    let frames = match frames {
-        Some(f) => f,
-        None => scene_frames(scene_path)?,
-    };
+    let SceneBudget {
+        bound,
+        own,
+        frames: whole,
+        rest,
+    } = scene_budget(scene_path)?;
+    let frames = frames.unwrap_or(whole);
     let reference = REFERENCE_SUBSTEPS.max(3 * own);
     let ref_state = run_at(scene_path, reference, frames)
         .with_context(|| format!("{}: the reference run", scene_path.display()))?;

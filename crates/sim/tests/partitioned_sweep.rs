@@ -5,43 +5,18 @@
 
 mod common;
 
-use common::{block_mesh, soft, worst_gap};
-use glam::{UVec3, Vec3};
-use incise_sim::grab::Grab;
-use incise_sim::selection::NodeSelection;
+use common::worst_gap;
+use glam::Vec3;
+use incise_sim::Solver;
 use incise_sim::xpbd::{CpuKernel, CpuSweep};
-use incise_sim::{Solver, SolverParams};
 
 /// The tearing bar of `common::tearing_bar` (10 × 3 × 3 cm, pinned at x = 0, pulled at
 /// x = 10 cm until it tears) with the sweep, kernel, threads and substeps given.
 fn bar(sweep: CpuSweep, kernel: CpuKernel, threads: usize, substeps: u32) -> Solver {
-    let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6));
-    let params = SolverParams {
-        threads,
-        substeps,
-        cpu_sweep: sweep,
-        cpu_kernel: kernel,
-        release_threshold: Some(6e3),
-        ..SolverParams::default()
-    };
-    let mut s = common::solver(mesh, soft(30e3, 0.4), params);
-    let rest = s.mesh().rest_positions.clone();
-    let side = |x: f32, n: Vec3| {
-        NodeSelection::PlaneSide {
-            point: Vec3::new(x, 0.0, 0.0),
-            normal: n,
-        }
-        .select(&rest)
-        .unwrap()
-    };
-    s.pin(&side(0.002, -Vec3::X));
-    s.add_grab(Grab {
-        nodes: side(0.098, Vec3::X),
-        waypoints: vec![Vec3::new(0.05, 0.0, 0.01)],
-        speed: 0.1,
-        start_time: 0.0,
-    });
-    s
+    common::tearing_bar_with(|p| {
+        (p.cpu_sweep, p.cpu_kernel) = (sweep, kernel);
+        (p.threads, p.substeps) = (threads, substeps);
+    })
 }
 
 /// Positions after each of `frames` frames, and the live flags at the end.

@@ -114,17 +114,7 @@ impl Solver {
             .map(|&t| (colors[t as usize], groups[t as usize]))
             .collect();
         let plan = SweepPlan::new(&keys, ncolors);
-        let mut color_ranges = Vec::with_capacity(ncolors);
-        let mut begin = 0;
-        for c in 0..ncolors as u32 {
-            let end = begin
-                + order[begin..]
-                    .iter()
-                    .take_while(|&&t| colors[t as usize] == c)
-                    .count();
-            color_ranges.push(begin..end);
-            begin = end;
-        }
+        let color_ranges = plan.colour_ranges();
         let mut slot_of_tet = vec![0u32; mesh.tet_count()];
         for (s, &t) in order.iter().enumerate() {
             slot_of_tet[t as usize] = s as u32;

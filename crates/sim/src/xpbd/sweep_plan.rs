@@ -82,6 +82,17 @@ impl SweepPlan {
         }
     }
 
+    /// The slots of each colour (all its groups' runs, which are consecutive).
+    pub fn colour_ranges(&self) -> Vec<Range<usize>> {
+        (0..self.runs[0].len())
+            .map(|c| {
+                let runs = self.runs.iter().map(|g| &g[c]).filter(|r| !r.is_empty());
+                let start = runs.clone().map(|r| r.start).min().unwrap_or(0);
+                start..runs.map(|r| r.end).max().unwrap_or(start)
+            })
+            .collect()
+    }
+
     /// Slots projected in each phase (for tests and the bench).
     pub fn phase_sizes(&self) -> Vec<usize> {
         self.phases
@@ -121,5 +132,6 @@ mod tests {
         assert_eq!(p.phases[1], [8, 10, 12, 14]);
         assert_eq!(p.phases[2], [9, 11, 13]);
         assert_eq!(p.phase_sizes(), [4, 1, 1, 0]);
+        assert_eq!(p.colour_ranges(), [0..4, 4..6]);
     }
 }

@@ -128,14 +128,20 @@ pub fn compressed_cube(
 /// A 10 × 3 × 3 cm bar (E = 30 kPa, ν = 0.4, release at 6 kPa) pinned at x = 0 and pulled
 /// from x = 10 cm along (5, 0, 1) cm at 10 cm/s until it tears.
 pub fn tearing_bar(threads: usize) -> Solver {
+    tearing_bar_with(|p| p.threads = threads)
+}
+
+/// [`tearing_bar`] with its settings (release at 6 kPa, the rest default) changed by
+/// `adjust`.
+pub fn tearing_bar_with(adjust: impl FnOnce(&mut SolverParams)) -> Solver {
     use incise_sim::grab::Grab;
     use incise_sim::selection::NodeSelection;
     let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6));
-    let params = SolverParams {
-        threads,
+    let mut params = SolverParams {
         release_threshold: Some(6e3),
         ..SolverParams::default()
     };
+    adjust(&mut params);
     let mut s = solver(mesh, soft(30e3, 0.4), params);
     let rest = s.mesh().rest_positions.clone();
     let left = NodeSelection::PlaneSide {
