@@ -3,7 +3,9 @@
 //! scripted (grabs, the scalpel's stroke, cutting) over its whole duration (or
 //! `--frames`) at the fewest substeps the stability bound allows, at the scene's own
 //! count, and at a reference count (≥ [`REFERENCE_SUBSTEPS`] and ≥ 3× the scene's); the
-//! table compares the end state with the reference: the von Mises field over the tets
+//! table compares the end state with the reference (always XPBD: a scene whose
+//! `solver.scheme` is `Newton` gets one more row, the scene's own implicit scheme, beside
+//! the XPBD rows at the bound and at its `substeps`): the von Mises field over the tets
 //! live in both, the displacement field, the released tets and the frame of the first
 //! release, the largest displacement (a cantilever's tip sag) and the volume error
 //! `mean |J − 1|`. A run the solver stops (an inverted tet) is a row that says so.
@@ -14,6 +16,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use glam::Vec3;
 use incise_sim::Solver;
+use incise_sim::implicit::Scheme;
 
 use crate::scene::{build_scene, load_scene};
 
@@ -53,10 +56,13 @@ struct EndState {
 pub struct BudgetRow {
     /// Scene file as given.
     pub scene: String,
-    /// Substeps per frame of this run.
+    /// Substeps (XPBD) or implicit steps (Newton) per frame of this run.
     pub substeps: u32,
-    /// What this count is: "bound", "scene", "bound = scene" or "reference".
+    /// What this count is: "bound", "scene", "bound = scene", "xpbd" (a Newton scene's
+    /// substeps under XPBD) or "reference".
     pub role: &'static str,
+    /// The scheme of this run.
+    pub scheme: Scheme,
     /// `‖σ_vM − σ_vM,ref‖ / ‖σ_vM,ref‖` over the tets live in both runs.
     pub stress_error: f64,
     /// `‖x − x_ref‖ / ‖x_ref − X‖` over the nodes.
@@ -100,10 +106,33 @@ impl BudgetRow {
     }
 }
 
-/// Run `scene` for `frames` frames at `substeps`.
-fn run_at(scene_path: &Path, substeps: u32, frames: u32) -> Result<EndState> {
+/// What one run changes in its scene.
+#[derive(Debug, Clone, Copy)]
+enum Run {
+    /// XPBD at this many substeps.
+    Xpbd(u32),
+    /// The scene's own solver settings.
+    AsScene,
+}
+
+impl Run {
+    /// The scheme and steps a frame this run uses in a scene whose solver is `own`.
+    fn settings(self, own: &incise_sim::SolverParams) -> (Scheme, u32) {
+        match self {
+            Run::Xpbd(n) => (Scheme::Xpbd, n),
+            Run::AsScene => (own.scheme, own.steps()),
+        }
+    }
+}
+
+/// Run `scene` for `frames` frames as `run` says.
+fn run_at(scene_path: &Path, run: Run, frames: u32) -> Result<EndState> {
     let mut scene = load_scene(scene_path)?;
-    scene.solver.substeps = substeps;
+    if let Run::Xpbd(n) = run {
+        scene.solver.scheme = Scheme::Xpbd;
+        scene.solver.substeps = n;
+    }
+    let substeps = scene.solver.steps();
     let built = build_scene(&scene, scene_path, None)
         .with_context(|| format!("{}: {substeps} substeps", scene_path.display()))?;
     let mut solver = built.solver;
@@ -194,7 +223,7 @@ fn displacement_error(x: &[Vec3], reference: &[Vec3], rest: &[Vec3]) -> f64 {
 /// The row of one run (`Err`: the run stopped).
 fn row(
     (scene, frames): (&Path, u32),
-    (substeps, role): (u32, &'static str),
+    ((scheme, substeps), role): ((Scheme, u32), &'static str),
     run: Result<EndState>,
     reference: &EndState,
     rest: &[Vec3],
@@ -203,6 +232,7 @@ fn row(
         scene: scene.display().to_string(),
         substeps,
         role,
+        scheme,
         stress_error: f64::NAN,
         displacement_error: f64::NAN,
         released: 0,
@@ -239,6 +269,8 @@ struct SceneBudget {
     bound: u32,
     /// The scene's own substeps.
     own: u32,
+    /// The scene's solver settings.
+    params: incise_sim::SolverParams,
     /// Frames of the scene's whole duration.
     frames: u32,
     /// Rest positions.
@@ -252,6 +284,7 @@ fn scene_budget(scene_path: &Path) -> Result<SceneBudget> {
     Ok(SceneBudget {
         bound: s.fewest_stable_substeps().max(1),
         own: s.params().substeps,
+        params: s.params().clone(),
         frames: (scene.duration as f64 / s.params().frame_dt as f64 - 1e-6).ceil() as u32,
         rest: s.mesh().rest_positions.clone(),
     })
@@ -265,28 +298,33 @@ pub fn measure(scene_path: &Path, frames: Option<u32>) -> Result<Vec<BudgetRow>>
         own,
         frames: whole,
         rest,
+        params,
     } = scene_budget(scene_path)?;
     let frames = frames.unwrap_or(whole);
     let reference = REFERENCE_SUBSTEPS.max(3 * own);
-    let ref_state = run_at(scene_path, reference, frames)
+    let ref_state = run_at(scene_path, Run::Xpbd(reference), frames)
         .with_context(|| format!("{}: the reference run", scene_path.display()))?;
+    let xpbd_scene = params.scheme == Scheme::Xpbd;
     let mut counts = vec![(
-        bound,
-        if bound == own {
+        Run::Xpbd(bound),
+        if bound == own && xpbd_scene {
             "bound = scene"
         } else {
             "bound"
         },
     )];
     if own != bound {
-        counts.push((own, "scene"));
+        counts.push((Run::Xpbd(own), if xpbd_scene { "scene" } else { "xpbd" }));
+    }
+    if !xpbd_scene {
+        counts.push((Run::AsScene, "scene"));
     }
     let mut rows: Vec<BudgetRow> = counts
         .into_iter()
         .map(|c| {
             row(
                 (scene_path, frames),
-                c,
+                (c.0.settings(&params), c.1),
                 run_at(scene_path, c.0, frames),
                 &ref_state,
                 &rest,
@@ -296,7 +334,7 @@ pub fn measure(scene_path: &Path, frames: Option<u32>) -> Result<Vec<BudgetRow>>
     let own_ref = Ok(ref_state.clone());
     rows.push(row(
         (scene_path, frames),
-        (reference, "reference"),
+        ((Scheme::Xpbd, reference), "reference"),
         own_ref,
         &ref_state,
         &rest,
@@ -311,8 +349,8 @@ pub fn markdown(rows: &[BudgetRow]) -> String {
          reference run (stress over the tets live in both); converged: both ≤ {:.0} %, the \
          released tets within {:.0} % of the reference's and the first release within {} \
          frames of it.\n\n\
-         | scene | frames | substeps | which | σvM field error | displacement error | released tets | first release (frame) | max \\|u\\| mm | mean \\|J − 1\\| | converged | ms/frame |\n\
-         |---|---:|---:|---|---:|---:|---:|---:|---:|---:|---|---:|\n",
+         | scene | frames | substeps | which | σvM field error | displacement error | released tets | first release (frame) | max \\|u\\| mm | mean \\|J − 1\\| | converged | ms/frame | scheme |\n\
+         |---|---:|---:|---|---:|---:|---:|---:|---:|---:|---|---:|---|\n",
         CONVERGED * 100.0,
         RELEASED_WITHIN * 100.0,
         FIRST_RELEASE_WITHIN,
@@ -326,12 +364,16 @@ pub fn markdown(rows: &[BudgetRow]) -> String {
 fn table_row(r: &BudgetRow) -> String {
     if let Some(why) = &r.failure {
         return format!(
-            "| {} | {} | {} | {} | – | – | – | – | – | – | no: {why} | – |\n",
-            r.scene, r.frames, r.substeps, r.role
+            "| {} | {} | {} | {} | – | – | – | – | – | – | no: {why} | – | {} |\n",
+            r.scene,
+            r.frames,
+            r.substeps,
+            r.role,
+            scheme_name(&r.scheme)
         );
     }
     format!(
-        "| {} | {} | {} | {} | {:.2} % | {:.2} % | {} | {} | {:.2} | {:.2e} | {} | {:.1} |\n",
+        "| {} | {} | {} | {} | {:.2} % | {:.2} % | {} | {} | {:.2} | {:.2e} | {} | {:.1} | {} |\n",
         r.scene,
         r.frames,
         r.substeps,
@@ -343,8 +385,20 @@ fn table_row(r: &BudgetRow) -> String {
         r.max_displacement * 1e3,
         r.volume_error,
         if r.converged() { "yes" } else { "no" },
-        r.ms_per_frame
+        r.ms_per_frame,
+        scheme_name(&r.scheme)
     )
+}
+
+/// The scheme as a table cell: `XPBD`, or `Newton` with its iterations and CG products.
+fn scheme_name(s: &Scheme) -> String {
+    match s {
+        Scheme::Xpbd => "XPBD".into(),
+        Scheme::Newton(p) => format!(
+            "Newton: {} iterations, ≤ {} CG products, tolerance {}",
+            p.iterations, p.cg_iterations, p.cg_tolerance
+        ),
+    }
 }
 
 /// Measure `scenes` over `frames` frames each (`None`: each scene's whole duration) and

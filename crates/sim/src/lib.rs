@@ -12,6 +12,7 @@ pub mod generate;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod grab;
+pub mod implicit;
 pub mod io;
 pub mod mass_spring;
 pub mod material;

@@ -37,6 +37,11 @@ pub enum GpuError {
         /// Bytes allowed.
         limit: u64,
     },
+    /// The scene's scheme has no GPU kernels.
+    #[error(
+        "solver.scheme Newton runs on the CPU only (the GPU solver is XPBD's): use --device cpu, or scheme: Xpbd for the GPU"
+    )]
+    CpuOnlyScheme,
     /// Reading results back failed (device lost, out of memory).
     #[error("GPU readback failed: {0}")]
     Readback(String),

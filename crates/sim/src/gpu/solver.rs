@@ -159,6 +159,9 @@ fn entries<'a>(list: &[&'a wgpu::Buffer]) -> Vec<wgpu::BindGroupEntry<'a>> {
 impl GpuSolver {
     /// Upload `host`'s state (mesh, rest data, colouring, pins, grabs) to the device.
     pub fn new(host: Solver, ctx: &GpuContext) -> Result<Self, GpuError> {
+        if host.params.scheme != crate::implicit::Scheme::Xpbd {
+            return Err(GpuError::CpuOnlyScheme);
+        }
         let device = ctx.device.clone();
         let queue = ctx.queue.clone();
         let n = host.x.len();

@@ -3,6 +3,7 @@
 mod coloring;
 mod flop_count;
 mod frame;
+mod implicit_step;
 mod lane;
 #[cfg(target_arch = "x86_64")]
 mod lane_avx;

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{ConstraintPair, TetProjection};
 use crate::contact::{ContactError, CutZone};
+use crate::implicit::{CoarseError, Scheme};
 use crate::material::{HydrostaticStiffness, Material};
 use crate::stress::StressMeasure;
 
@@ -43,6 +44,9 @@ pub enum CpuSweep {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverParams {
+    /// How a frame is advanced: `Xpbd` small steps (default) or `Newton(..)` implicit
+    /// Euler steps (`crate::implicit`).
+    pub scheme: Scheme,
     /// Frame time step, s (60 Hz by default).
     pub frame_dt: f32,
     /// Substeps per frame (one constraint iteration each, PHYSICS.md §1.2).
@@ -85,6 +89,7 @@ pub struct SolverParams {
 impl Default for SolverParams {
     fn default() -> Self {
         SolverParams {
+            scheme: Scheme::Xpbd,
             frame_dt: 1.0 / 60.0,
             substeps: 10,
             gravity: Vec3::new(0.0, 0.0, -9.81),
@@ -110,9 +115,39 @@ impl SolverParams {
         self.frame_dt / self.substeps as f32
     }
 
+    /// Steps a frame is advanced in: XPBD substeps or implicit Euler steps.
+    pub fn steps(&self) -> u32 {
+        match self.scheme {
+            Scheme::Xpbd => self.substeps,
+            Scheme::Newton(p) => p.steps,
+        }
+    }
+
+    /// Length of one of those steps, s.
+    pub fn step_length(&self) -> f32 {
+        self.frame_dt / self.steps() as f32
+    }
+
     /// Check ranges; the message names the field.
     pub fn validate(&self) -> Result<(), SolverError> {
         let bad = |field: &'static str, msg: String| Err(SolverError::BadParameter { field, msg });
+        if let Scheme::Newton(p) = &self.scheme {
+            if let Err((field, msg)) = p.validate() {
+                return bad(field, msg);
+            }
+            if self.constraints != ConstraintPair::RestFree {
+                return bad(
+                    "scheme",
+                    "Newton minimises the rest-free Neo-Hookean energy: it needs constraints: RestFree".into(),
+                );
+            }
+            if self.stress != StressMeasure::Cauchy {
+                return bad(
+                    "scheme",
+                    "Newton has no XPBD multipliers for the seed's eq. 3 stress: it needs stress: Cauchy".into(),
+                );
+            }
+        }
         if !(self.frame_dt.is_finite() && self.frame_dt > 0.0 && self.frame_dt <= 0.1) {
             return bad(
                 "frame_dt",
@@ -255,6 +290,9 @@ pub enum SolverError {
     /// The tool cannot be used.
     #[error(transparent)]
     Tool(#[from] ContactError),
+    /// The implicit scheme's coarse level could not be built.
+    #[error(transparent)]
+    Coarse(#[from] CoarseError),
     /// The GPU device failed while stepping (device lost, readback failed).
     #[error("GPU: {0}")]
     Device(String),

@@ -22,6 +22,7 @@ use super::{CpuKernel, CpuSweep, FrameStats, SolverError, SolverParams};
 use crate::contact::{ContactTool, CutZone, ToolMotion, ToolPose, project_node};
 use crate::cutting::{CutState, ReleaseEvent};
 use crate::grab::Grab;
+use crate::implicit::{NewtonReport, NewtonWorkspace, Scheme};
 use crate::material::{Lame, Material};
 use crate::mesh::TetMesh;
 use crate::stress::{StressMeasure, cauchy_stress, tet_stress, von_mises};
@@ -91,6 +92,9 @@ pub struct Solver {
     /// Parallel passes of the last frame (colours per substep, stress passes).
     pub(crate) passes: u32,
     pub(crate) pool: Option<rayon::ThreadPool>,
+    /// The implicit scheme's buffers and preconditioner, built at its first step (when
+    /// the pins and grabs are known).
+    pub(crate) newton: Option<NewtonWorkspace>,
 }
 
 impl Solver {
@@ -125,7 +129,8 @@ impl Solver {
             .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
             .collect();
         let (kappa, tet) = stiffness_number(&mesh, &inv_mass, lame, params.substep());
-        if kappa > MAX_STIFFNESS_NUMBER {
+        // Implicit Euler has no step bound; only the XPBD small steps do.
+        if params.scheme == Scheme::Xpbd && kappa > MAX_STIFFNESS_NUMBER {
             return Err(SolverError::Unstable {
                 h_ms: params.substep() * 1e3,
                 tet,
@@ -179,6 +184,7 @@ impl Solver {
             check_ms: 0.0,
             passes: 0,
             pool,
+            newton: None,
             lame,
             params,
             mesh,
@@ -405,6 +411,10 @@ impl Solver {
         for &t in &ev.tets {
             self.slots[self.slot_of_tet[t as usize] as usize].live = false;
         }
+        if let Some(ws) = &mut self.newton {
+            // The coarse level only preconditions: a failed refresh keeps the old one.
+            let _ = ws.release(&ev.tets);
+        }
         for &n in &ev.retired_nodes {
             self.kind[n as usize] = NodeKind::Retired;
             self.inv_mass[n as usize] = 0.0;
@@ -424,7 +434,10 @@ impl Solver {
         let t0 = Instant::now();
         self.near_edge.iter_mut().for_each(|b| *b = false);
         self.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
-        let fresh = self.with_pool(|s, parallel| s.run_substeps(parallel));
+        let fresh = match self.params.scheme {
+            Scheme::Xpbd => self.with_pool(|s, parallel| s.run_substeps(parallel)),
+            Scheme::Newton(p) => self.with_pool(|s, parallel| s.run_implicit_steps(p, parallel))?,
+        };
         self.time += self.params.frame_dt as f64;
         self.sync_positions();
         let t1 = Instant::now();
@@ -506,16 +519,26 @@ impl Solver {
             }
             self.project_contacts(s, n);
             self.update_velocities(h);
-            fresh = false;
-            if next.next_if(|&&k| k == s).is_some() {
-                let t0 = Instant::now();
-                self.compute_stress(parallel);
-                self.switch_off_overstressed();
-                self.check_ms += t0.elapsed().as_secs_f64() * 1e3;
-                fresh = true;
+            fresh = next.next_if(|&&k| k == s).is_some();
+            if fresh {
+                self.release_check(parallel);
             }
         }
         fresh
+    }
+
+    /// Stress, then the tets over the threshold switched off (PHYSICS.md §1.4), timed.
+    pub(crate) fn release_check(&mut self, parallel: bool) {
+        let t0 = Instant::now();
+        self.compute_stress(parallel);
+        self.switch_off_overstressed();
+        self.check_ms += t0.elapsed().as_secs_f64() * 1e3;
+    }
+
+    /// The implicit scheme's last step: Newton iterations and conjugate-gradient products
+    /// (`None` under XPBD or before the first frame).
+    pub fn newton_report(&self) -> Option<NewtonReport> {
+        self.newton.as_ref().map(|w| w.last)
     }
 
     /// Push free nodes out of the tool as it moves through substep `s` of `n`
@@ -524,7 +547,7 @@ impl Solver {
     /// Projected after the tet constraints, not before as PHYSICS.md §1.2 lists them:
     /// with one iteration per substep the last projection is the one that holds, and
     /// this way every substep ends with no node inside the tool.
-    fn project_contacts(&mut self, s: u32, n: u32) {
+    pub(crate) fn project_contacts(&mut self, s: u32, n: u32) {
         let Some(motion) = &self.tool else {
             return;
         };
@@ -554,7 +577,7 @@ impl Solver {
     /// `v += h g; u_prev = u; u += h v` for free nodes; kinematic nodes jump to their
     /// target at the end of the substep.
     // PHYSICS.md §1.2, small-steps loop, prediction.
-    fn predict(&mut self, h: f32, t: f64) {
+    pub(crate) fn predict(&mut self, h: f32, t: f64) {
         let offsets: Vec<Vec3> = self.grabs.iter().map(|g| g.offset_at(t)).collect();
         let g = self.params.gravity;
         for i in 0..self.u.len() {
@@ -618,7 +641,7 @@ impl Solver {
 
     /// `v = (u − u_prev)/h` (= (x − x_prev)/h), then damping.
     // PHYSICS.md §1.2, small-steps loop, velocity update.
-    fn update_velocities(&mut self, h: f32) {
+    pub(crate) fn update_velocities(&mut self, h: f32) {
         let keep = (1.0 - self.params.damping * h).max(0.0);
         let inv_h = 1.0 / h;
         for i in 0..self.u.len() {
@@ -758,9 +781,9 @@ impl Solver {
     /// multipliers `f = Σ λ / h²` (PHYSICS.md §1.5), averaged over the substeps, with the
     /// sign of the reaction on the tool.
     pub fn tool_force(&self) -> Vec3 {
-        let h = self.params.substep();
+        let h = self.params.step_length();
         let push: Vec3 = self.contact_push.iter().sum();
-        -push / (h * h * self.params.substeps as f32)
+        -push / (h * h * self.params.steps() as f32)
     }
 
     /// Frame statistics over the live tets (PHYSICS.md §1.3 stress, volume, energy).
@@ -789,7 +812,7 @@ impl Solver {
         FrameStats {
             frame: self.frame,
             sim_time: self.time,
-            substeps: self.params.substeps,
+            substeps: self.params.steps(),
             max_von_mises: max_vm,
             mean_von_mises: if live > 0 {
                 (sum_vm / live as f64) as f32

@@ -1,0 +1,183 @@
+//! The coarse level of the two-level preconditioner: a regular grid of cubes laid over
+//! the body, each free node interpolated trilinearly from the eight corners of its cube
+//! (the prolongation `P`). Only corners that carry enough of the free nodes' weight are
+//! kept, so the coarse unknowns follow the body's shape, not its bounding box.
+
+use std::collections::HashMap;
+
+use glam::{UVec3, Vec3};
+
+/// The eight corner offsets of a cube, in trilinear order.
+const CORNERS: [UVec3; 8] = [
+    UVec3::new(0, 0, 0),
+    UVec3::new(1, 0, 0),
+    UVec3::new(0, 1, 0),
+    UVec3::new(1, 1, 0),
+    UVec3::new(0, 0, 1),
+    UVec3::new(1, 0, 1),
+    UVec3::new(0, 1, 1),
+    UVec3::new(1, 1, 1),
+];
+
+/// A fine node's coarse corners and their weights (all zero for a node that is not free).
+pub type NodeWeights = [(u32, f32); 8];
+
+/// The prolongation from coarse corners to fine nodes.
+#[derive(Debug, Clone)]
+pub struct CoarseGrid {
+    /// Edge of a cube, m.
+    pub cell: f32,
+    /// Per fine node: its coarse corners and weights (they sum to 1 for a free node).
+    pub weights: Vec<NodeWeights>,
+    /// Coarse nodes kept.
+    pub count: usize,
+}
+
+impl CoarseGrid {
+    /// The grid of cubes of edge `cell` over `points`; nodes with `free[i] == false` get no
+    /// weights (their values are fixed, not solved for).
+    pub fn new(points: &[Vec3], free: &[bool], cell: f32) -> Self {
+        let origin = points
+            .iter()
+            .fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p))
+            - Vec3::splat(0.5 * cell);
+        let mut ids: HashMap<UVec3, u32> = HashMap::new();
+        let mut weights = vec![[(0u32, 0.0f32); 8]; points.len()];
+        let mut support: Vec<f32> = Vec::new();
+        for (i, p) in points.iter().enumerate() {
+            if !free[i] {
+                continue;
+            }
+            let g = (*p - origin) / cell;
+            let base = g.floor();
+            let t = g - base;
+            let base = base.as_uvec3();
+            for (k, c) in CORNERS.iter().enumerate() {
+                let next = ids.len() as u32;
+                let id = *ids.entry(base + *c).or_insert(next);
+                support.resize(ids.len(), 0.0);
+                let w = trilinear(t, *c);
+                support[id as usize] += w;
+                weights[i][k] = (id, w);
+            }
+        }
+        let count = prune(&mut weights, &support);
+        CoarseGrid {
+            cell,
+            weights,
+            count,
+        }
+    }
+
+    /// `Pᵀ r`: fine node vectors summed onto the coarse nodes (f64, 3 per node).
+    pub fn restrict(&self, r: &[Vec3], out: &mut [f64]) {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for (w, r) in self.weights.iter().zip(r) {
+            for &(id, wk) in w {
+                let o = 3 * id as usize;
+                out[o] += (wk * r.x) as f64;
+                out[o + 1] += (wk * r.y) as f64;
+                out[o + 2] += (wk * r.z) as f64;
+            }
+        }
+    }
+
+    /// `z += P c`: coarse values interpolated onto the fine nodes.
+    pub fn prolong_add(&self, c: &[f64], z: &mut [Vec3]) {
+        for (w, z) in self.weights.iter().zip(z) {
+            for &(id, wk) in w {
+                let o = 3 * id as usize;
+                *z += wk * Vec3::new(c[o] as f32, c[o + 1] as f32, c[o + 2] as f32);
+            }
+        }
+    }
+}
+
+/// Least total weight a corner must carry to be a coarse node, in fine nodes: a corner
+/// that only grazes the body (a node or two near the far side of its cubes) would make a
+/// column nearly dependent on its neighbours' and the coarse matrix numerically singular.
+const MIN_SUPPORT: f32 = 0.5;
+
+/// Drop corners supporting less than [`MIN_SUPPORT`], renormalise each node's remaining
+/// weights to sum to 1 (constants still interpolate exactly) and number the kept corners
+/// densely; returns how many are kept.
+fn prune(weights: &mut [NodeWeights], support: &[f32]) -> usize {
+    let mut dense = vec![u32::MAX; support.len()];
+    let mut count = 0u32;
+    for (id, s) in support.iter().enumerate() {
+        if *s >= MIN_SUPPORT {
+            dense[id] = count;
+            count += 1;
+        }
+    }
+    for w in weights.iter_mut() {
+        let mut total = 0.0;
+        for (id, wk) in w.iter_mut() {
+            if *wk > 0.0 && dense[*id as usize] != u32::MAX {
+                *id = dense[*id as usize];
+                total += *wk;
+            } else {
+                *id = 0;
+                *wk = 0.0;
+            }
+        }
+        for (_, wk) in w.iter_mut() {
+            *wk = if total > 0.0 { *wk / total } else { 0.0 };
+        }
+    }
+    count as usize
+}
+
+/// The trilinear weight of corner `c` at local coordinates `t` in the cube.
+fn trilinear(t: Vec3, c: UVec3) -> f32 {
+    let axis = |t: f32, c: u32| if c == 1 { t } else { 1.0 - t };
+    axis(t.x, c.x) * axis(t.y, c.y) * axis(t.z, c.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_sum_to_one_and_restriction_is_the_transpose() {
+        let pts: Vec<Vec3> = (0..50)
+            .map(|i| {
+                let f = i as f32;
+                Vec3::new((f * 0.37).sin(), (f * 0.71).cos(), f * 0.013)
+            })
+            .collect();
+        let free = vec![true; pts.len()];
+        let grid = CoarseGrid::new(&pts, &free, 0.3);
+        for w in &grid.weights {
+            let s: f32 = w.iter().map(|(_, w)| w).sum();
+            assert!(s == 0.0 || (s - 1.0).abs() < 1e-5, "{s}");
+        }
+        assert!(grid.weights.iter().any(|w| w.iter().any(|(_, w)| *w > 0.0)));
+        let r: Vec<Vec3> = pts.iter().map(|p| *p * 2.0 + Vec3::X).collect();
+        let c: Vec<f64> = (0..3 * grid.count)
+            .map(|k| (k as f64 * 0.1).cos())
+            .collect();
+        let mut pr = vec![0.0; 3 * grid.count];
+        grid.restrict(&r, &mut pr);
+        let mut z = vec![Vec3::ZERO; pts.len()];
+        grid.prolong_add(&c, &mut z);
+        // (Pᵀ r)·c == r·(P c)
+        let lhs: f64 = pr.iter().zip(&c).map(|(a, b)| a * b).sum();
+        let rhs: f64 = r.iter().zip(&z).map(|(a, b)| a.dot(*b) as f64).sum();
+        assert!(
+            (lhs - rhs).abs() < 1e-4 * lhs.abs().max(1.0),
+            "{lhs} vs {rhs}"
+        );
+    }
+
+    #[test]
+    fn fixed_nodes_get_no_weight() {
+        let pts = vec![Vec3::ZERO, Vec3::ONE];
+        let grid = CoarseGrid::new(&pts, &[true, false], 0.5);
+        assert!(grid.weights[1].iter().all(|(_, w)| *w == 0.0));
+        // The free node sits at the middle of its cube (the grid starts half a cube
+        // below the lowest point): each corner carries 1/8, too little to be kept.
+        assert_eq!(grid.count, 0);
+        assert!(grid.weights[0].iter().all(|(_, w)| *w == 0.0));
+    }
+}

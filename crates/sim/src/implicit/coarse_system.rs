@@ -1,0 +1,339 @@
+//! The coarse level's matrix `A_c = Pᵀ A P` (Galerkin) and its sparse Cholesky factor.
+//!
+//! `A` is `M/h² + K`, with `K` the small-strain (rest) stiffness of the live tets, so the
+//! pattern is fixed from the start: a released tet only subtracts its own contribution
+//! and the factor is refreshed numerically on the same symbolic analysis
+//! (`../shared/SOLVERS.md`, "a cut that only releases tets never changes the sparsity
+//! pattern"). The fine level corrects what the rest stiffness gets wrong (rotations,
+//! large strain): this is only the preconditioner's coarse part.
+
+use std::collections::HashMap;
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{MatMut, Side};
+use glam::{Mat3, Vec3};
+
+use super::coarse_grid::CoarseGrid;
+use crate::material::Lame;
+use crate::vbd::shape_gradients;
+
+/// Why the coarse factorisation failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("the coarse level of the implicit solver could not be factorised: {0}")]
+pub struct CoarseError(String);
+
+/// One tet as the coarse assembly reads it.
+#[derive(Debug, Clone, Copy)]
+pub struct RestTet {
+    /// Its four nodes.
+    pub nodes: [u32; 4],
+    /// Inverse rest shape matrix.
+    pub dm_inv: Mat3,
+    /// Rest volume, m³.
+    pub volume: f32,
+}
+
+/// `A_c` in 3×3 blocks (lower triangle) and its factor.
+pub struct CoarseSystem {
+    /// Block `(row, col)` with row ≥ col → its index in `blocks`.
+    index: HashMap<(u32, u32), usize>,
+    /// Row-major 3×3 values of each block.
+    blocks: Vec<[f64; 9]>,
+    /// Per block, the position of each of its nine values in the CSC values (`u32::MAX`
+    /// above the diagonal of a diagonal block).
+    position: Vec<[u32; 9]>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    values: Vec<f64>,
+    symbolic: SymbolicLlt<usize>,
+    factor: Llt<usize, f64>,
+}
+
+impl CoarseSystem {
+    /// `Pᵀ (M/h² + K) P` over `tets` (live ones) and the nodes' `mass`, factorised.
+    pub fn new(
+        grid: &CoarseGrid,
+        tets: &[RestTet],
+        mass: &[f32],
+        inv_h2: f32,
+        lame: Lame,
+    ) -> Result<Self, CoarseError> {
+        let mut index = HashMap::new();
+        let mut blocks = Vec::new();
+        let mut add = |v: u32, w: u32, b: Mat3, scale: f64| {
+            let k = *index.entry((v, w)).or_insert_with(|| {
+                blocks.push([0.0; 9]);
+                blocks.len() - 1
+            });
+            accumulate(&mut blocks[k], &b, scale);
+        };
+        for t in tets {
+            tet_contribution(grid, t, lame, &mut |v, w, b| add(v, w, b, 1.0));
+        }
+        for (i, w) in grid.weights.iter().enumerate() {
+            node_mass(w, mass[i] * inv_h2, &mut |v, u, b| add(v, u, b, 1.0));
+        }
+        let n = 3 * grid.count;
+        let (col_ptr, row_idx, position) = pattern(&index, grid.count);
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let symbolic =
+            SymbolicLlt::try_new(sym, Side::Lower).map_err(|e| CoarseError(format!("{e:?}")))?;
+        let values = block_values(&blocks, &position, row_idx.len());
+        let factor = factorise(&symbolic, &col_ptr, &row_idx, &values)?;
+        Ok(CoarseSystem {
+            index,
+            blocks,
+            position,
+            col_ptr,
+            row_idx,
+            values,
+            symbolic,
+            factor,
+        })
+    }
+
+    /// Subtract released tets' stiffness and refactorise on the same pattern.
+    pub fn release(
+        &mut self,
+        grid: &CoarseGrid,
+        tets: &[RestTet],
+        lame: Lame,
+    ) -> Result<(), CoarseError> {
+        for t in tets {
+            tet_contribution(grid, t, lame, &mut |v, w, b| {
+                if let Some(&k) = self.index.get(&(v, w)) {
+                    accumulate(&mut self.blocks[k], &b, -1.0);
+                }
+            });
+        }
+        self.refactor()
+    }
+
+    /// Solve `A_c x = b` in place (3 values per coarse node).
+    pub fn solve(&self, b: &mut [f64]) {
+        let n = b.len();
+        self.factor
+            .solve_in_place(MatMut::from_column_major_slice_mut(b, n, 1));
+    }
+
+    /// Nonzeros of the lower triangle of `A_c`.
+    pub fn nonzeros(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Copy the blocks into the CSC values and factorise numerically.
+    fn refactor(&mut self) -> Result<(), CoarseError> {
+        self.values = block_values(&self.blocks, &self.position, self.row_idx.len());
+        self.factor = factorise(&self.symbolic, &self.col_ptr, &self.row_idx, &self.values)?;
+        Ok(())
+    }
+}
+
+/// The CSC values of `blocks` placed at `position`.
+fn block_values(blocks: &[[f64; 9]], position: &[[u32; 9]], len: usize) -> Vec<f64> {
+    let mut values = vec![0.0; len];
+    for (b, pos) in blocks.iter().zip(position) {
+        for k in 0..9 {
+            if pos[k] != u32::MAX {
+                values[pos[k] as usize] = b[k];
+            }
+        }
+    }
+    values
+}
+
+/// The numeric LLᵀ factor of the lower-triangle CSC matrix on `symbolic`'s analysis.
+fn factorise(
+    symbolic: &SymbolicLlt<usize>,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    values: &[f64],
+) -> Result<Llt<usize, f64>, CoarseError> {
+    let n = col_ptr.len() - 1;
+    let sym = SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx);
+    Llt::try_new_with_symbolic(
+        symbolic.clone(),
+        SparseColMatRef::new(sym, values),
+        Side::Lower,
+    )
+    .map_err(|e| CoarseError(format!("{e:?}")))
+}
+
+/// `b += scale · m` in row-major order.
+fn accumulate(b: &mut [f64; 9], m: &Mat3, scale: f64) {
+    for r in 0..3 {
+        for c in 0..3 {
+            b[3 * r + c] += scale * m.col(c)[r] as f64;
+        }
+    }
+}
+
+/// The small-strain stiffness block `∂²E/∂x_a∂x_b` of a tet with shape gradients `b`:
+/// `V [μ (b_a·b_b) I + μ b_b b_aᵀ + λ b_a b_bᵀ]` (linear elasticity, the tangent of
+/// [`super::TetTangent`] at rest).
+fn rest_block(b: &[Vec3; 4], a: usize, c: usize, volume: f32, lame: Lame) -> Mat3 {
+    let outer = |x: Vec3, y: Vec3| Mat3::from_cols(x * y.x, x * y.y, x * y.z);
+    (Mat3::IDENTITY * (lame.mu * b[a].dot(b[c]))
+        + outer(b[c], b[a]) * lame.mu
+        + outer(b[a], b[c]) * lame.lambda)
+        * volume
+}
+
+/// Call `out(v, w, block)` for the lower-triangle coarse blocks (v ≥ w) of `Pᵀ K_t P`.
+fn tet_contribution(
+    grid: &CoarseGrid,
+    t: &RestTet,
+    lame: Lame,
+    out: &mut impl FnMut(u32, u32, Mat3),
+) {
+    let b = shape_gradients(&t.dm_inv);
+    let mut local: Vec<(u32, u32, Mat3)> = Vec::with_capacity(256);
+    for a in 0..4 {
+        for c in 0..4 {
+            let k = rest_block(&b, a, c, t.volume, lame);
+            for &(v, wa) in &grid.weights[t.nodes[a] as usize] {
+                for &(w, wc) in &grid.weights[t.nodes[c] as usize] {
+                    if v >= w && wa * wc != 0.0 {
+                        merge(&mut local, v, w, k * (wa * wc));
+                    }
+                }
+            }
+        }
+    }
+    for (v, w, m) in local {
+        out(v, w, m);
+    }
+}
+
+/// Add `m` to the entry `(v, w)` of a short list.
+fn merge(local: &mut Vec<(u32, u32, Mat3)>, v: u32, w: u32, m: Mat3) {
+    match local.iter_mut().find(|(a, b, _)| *a == v && *b == w) {
+        Some(e) => e.2 += m,
+        None => local.push((v, w, m)),
+    }
+}
+
+/// Call `out(v, w, block)` for a node's mass term `Pᵀ (m/h² I) P` (lower triangle).
+fn node_mass(weights: &[(u32, f32); 8], m: f32, out: &mut impl FnMut(u32, u32, Mat3)) {
+    for &(v, wv) in weights {
+        for &(w, ww) in weights {
+            if v >= w && wv * ww != 0.0 {
+                out(v, w, Mat3::IDENTITY * (m * wv * ww));
+            }
+        }
+    }
+}
+
+/// The scalar CSC pattern (lower triangle) of the blocks in `index`, and where each
+/// block's values go.
+fn pattern(
+    index: &HashMap<(u32, u32), usize>,
+    nodes: usize,
+) -> (Vec<usize>, Vec<usize>, Vec<[u32; 9]>) {
+    let mut by_col: Vec<Vec<(u32, usize)>> = vec![Vec::new(); nodes];
+    for (&(v, w), &k) in index {
+        by_col[w as usize].push((v, k));
+    }
+    let mut col_ptr = vec![0usize];
+    let mut row_idx = Vec::new();
+    let mut position = vec![[u32::MAX; 9]; index.len()];
+    for (w, rows) in by_col.iter_mut().enumerate() {
+        rows.sort_unstable();
+        for c in 0..3 {
+            let col = 3 * w + c;
+            for &(v, k) in rows.iter() {
+                for r in 0..3 {
+                    let row = 3 * v as usize + r;
+                    if row >= col {
+                        position[k][3 * r + c] = row_idx.len() as u32;
+                        row_idx.push(row);
+                    }
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+    }
+    (col_ptr, row_idx, position)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::block;
+    use crate::mesh::TetMesh;
+
+    fn lame() -> Lame {
+        Lame {
+            mu: 6.2e4,
+            lambda: 5.59e5,
+        }
+    }
+
+    /// The coarse matrix of a block of tets against `Pᵀ A P` formed densely.
+    #[test]
+    fn the_coarse_matrix_is_the_galerkin_product_and_factorises() {
+        let raw = block(
+            Vec3::ZERO,
+            Vec3::new(0.04, 0.02, 0.01),
+            glam::UVec3::new(8, 4, 2),
+        );
+        let mesh = TetMesh::from_raw(raw).unwrap().0;
+        let n = mesh.node_count();
+        let free: Vec<bool> = (0..n).map(|i| mesh.rest_positions[i].x > 1e-4).collect();
+        let grid = CoarseGrid::new(&mesh.rest_positions, &free, 0.012);
+        let tets: Vec<RestTet> = (0..mesh.tet_count())
+            .map(|t| RestTet {
+                nodes: mesh.tets[t],
+                dm_inv: mesh.dm_inv[t],
+                volume: mesh.rest_volume[t],
+            })
+            .collect();
+        let mass = mesh.lumped_masses(1040.0);
+        let sys = CoarseSystem::new(&grid, &tets, &mass, 3600.0, lame()).unwrap();
+        let nc = 3 * grid.count;
+        // Dense Pᵀ A P.
+        let mut dense = vec![0.0f64; nc * nc];
+        for t in &tets {
+            let b = shape_gradients(&t.dm_inv);
+            for a in 0..4 {
+                for c in 0..4 {
+                    let k = rest_block(&b, a, c, t.volume, lame());
+                    for &(v, wa) in &grid.weights[t.nodes[a] as usize] {
+                        for &(w, wc) in &grid.weights[t.nodes[c] as usize] {
+                            for r in 0..3 {
+                                for q in 0..3 {
+                                    dense[(3 * v as usize + r) * nc + 3 * w as usize + q] +=
+                                        (wa * wc * k.col(q)[r]) as f64;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for (i, w) in grid.weights.iter().enumerate() {
+            for &(v, wv) in w {
+                for &(u, wu) in w {
+                    for r in 0..3 {
+                        dense[(3 * v as usize + r) * nc + 3 * u as usize + r] +=
+                            (mass[i] * 3600.0 * wv * wu) as f64;
+                    }
+                }
+            }
+        }
+        // A_c x = b solved by the factor reproduces b.
+        let x: Vec<f64> = (0..nc).map(|k| ((k * 7) % 11) as f64 - 5.0).collect();
+        let mut b: Vec<f64> = (0..nc)
+            .map(|r| (0..nc).map(|c| dense[r * nc + c] * x[c]).sum())
+            .collect();
+        sys.solve(&mut b);
+        let err = b
+            .iter()
+            .zip(&x)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-3, "solve off by {err}");
+    }
+}

@@ -1,0 +1,19 @@
+//! The implicit scheme's pieces: one implicit Euler step per (frame / `steps`), its
+//! minimisation by Newton's method, each Newton system by a conjugate gradient
+//! preconditioned on two levels (block Jacobi on the tet mesh, a Cholesky-factorised
+//! Galerkin coarse grid). The tet solver ([`crate::xpbd::Solver`]) drives them when
+//! `solver.scheme` is `Newton`.
+
+mod coarse_grid;
+mod coarse_system;
+mod params;
+mod pcg;
+mod tet_tangent;
+mod workspace;
+
+pub use coarse_grid::CoarseGrid;
+pub use coarse_system::{CoarseError, CoarseSystem, RestTet};
+pub use params::{NewtonParams, Scheme};
+pub use pcg::{CgReport, dot, pcg};
+pub use tet_tangent::TetTangent;
+pub use workspace::{NewtonReport, NewtonWorkspace};

@@ -1,0 +1,82 @@
+//! Which time integrator the tet solver uses, and the implicit one's settings.
+
+use serde::{Deserialize, Serialize};
+
+/// How the tet solver advances a frame (`solver.scheme` in a scene).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum Scheme {
+    /// XPBD small steps (PHYSICS.md §1.2): `substeps` Gauss–Seidel sweeps a frame.
+    #[default]
+    Xpbd,
+    /// Implicit Euler steps solved by Newton's method with a two-level preconditioned
+    /// conjugate gradient (docs/physics-notes.md, "The implicit scheme").
+    Newton(NewtonParams),
+}
+
+/// Settings of the implicit scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NewtonParams {
+    /// Implicit Euler steps per frame.
+    pub steps: u32,
+    /// Newton iterations per step.
+    pub iterations: u32,
+    /// Most conjugate-gradient products per Newton iteration.
+    pub cg_iterations: u32,
+    /// The conjugate gradient stops when the preconditioned residual falls below this
+    /// fraction of its first value.
+    pub cg_tolerance: f32,
+    /// Edge of the coarse level's cubes, m (`None`: four mean rest edge lengths).
+    pub coarse_cell: Option<f32>,
+}
+
+impl Default for NewtonParams {
+    fn default() -> Self {
+        NewtonParams {
+            steps: 1,
+            iterations: 5,
+            cg_iterations: 100,
+            cg_tolerance: 0.01,
+            coarse_cell: None,
+        }
+    }
+}
+
+impl NewtonParams {
+    /// Check ranges: the field (under `solver.scheme`) and what is wrong.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        if self.steps == 0 || self.steps > 1000 {
+            return Err((
+                "scheme.steps",
+                format!("must be 1..=1000, got {}", self.steps),
+            ));
+        }
+        if self.iterations == 0 || self.iterations > 100 {
+            return Err((
+                "scheme.iterations",
+                format!("must be 1..=100, got {}", self.iterations),
+            ));
+        }
+        if self.cg_iterations == 0 || self.cg_iterations > 10_000 {
+            return Err((
+                "scheme.cg_iterations",
+                format!("must be 1..=10000, got {}", self.cg_iterations),
+            ));
+        }
+        if !(self.cg_tolerance.is_finite() && self.cg_tolerance > 0.0 && self.cg_tolerance < 1.0) {
+            return Err((
+                "scheme.cg_tolerance",
+                format!("must be in (0, 1), got {}", self.cg_tolerance),
+            ));
+        }
+        if let Some(c) = self.coarse_cell {
+            if !(c.is_finite() && c > 0.0) {
+                return Err((
+                    "scheme.coarse_cell",
+                    format!("must be a positive length in m, got {c}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
