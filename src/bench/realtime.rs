@@ -11,6 +11,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
+use incise_sim::implicit::{NewtonParams, Scheme};
 use incise_sim::xpbd::{CpuKernel, CpuSweep, NODE_FLOPS_PER_SUBSTEP, projection_flops};
 use serde::Serialize;
 
@@ -25,15 +26,17 @@ pub struct RealtimeResult {
     /// "cpu (N threads)" or the GPU adapter.
     pub device: String,
     /// The CPU projection kernel ("Lanes", "PortableLanes" or "Scalar"; the GPU ignores
-    /// it), with ", Blocks" for the partitioned sweep.
+    /// it), with ", Blocks" for the partitioned sweep; "Newton" for the implicit scheme.
     pub cpu_kernel: String,
+    /// The time integrator: "XPBD" or "Newton".
+    pub scheme: String,
     /// CPU solver threads (0 on the GPU).
     pub threads: usize,
     /// Tets.
     pub tets: usize,
     /// Nodes.
     pub nodes: usize,
-    /// Substeps per frame (the scene's).
+    /// Substeps (XPBD) or implicit steps (Newton) per frame.
     pub substeps: u32,
     /// Frame length, s.
     pub frame_dt: f32,
@@ -73,8 +76,9 @@ pub type CpuChoice = (Option<usize>, Option<CpuKernel>, Option<CpuSweep>);
 pub const MARKDOWN_RUNS: usize = 3;
 
 /// Time `frames` frames of `scene` on `device` and print a table row, the JSON, or (with
-/// `Markdown`) the three CPU kernels interleaved, [`MARKDOWN_RUNS`] runs each, as the
-/// markdown table of docs/performance.md under its provenance line.
+/// `Markdown`) the XPBD kernels and the implicit scheme (the scene's Newton settings, or
+/// the defaults) interleaved, [`MARKDOWN_RUNS`] runs each, as the markdown table of
+/// docs/performance.md under its provenance line.
 pub fn run(
     scene: &Path,
     device: DeviceChoice,
@@ -84,25 +88,33 @@ pub fn run(
 ) -> Result<()> {
     use crate::bench::BenchOutput;
     if output == BenchOutput::Markdown {
-        let kernels = match cpu.1 {
-            Some(k) => vec![(k, cpu.2)],
+        let xpbd = Some(Scheme::Xpbd);
+        let mut kernels = match cpu.1 {
+            Some(k) => vec![(k, cpu.2, xpbd)],
             None => vec![
-                (CpuKernel::Scalar, Some(CpuSweep::Coloured)),
-                (CpuKernel::PortableLanes, Some(CpuSweep::Coloured)),
-                (CpuKernel::Lanes, Some(CpuSweep::Coloured)),
-                (CpuKernel::Lanes, Some(CpuSweep::Blocks)),
+                (CpuKernel::Scalar, Some(CpuSweep::Coloured), xpbd),
+                (CpuKernel::PortableLanes, Some(CpuSweep::Coloured), xpbd),
+                (CpuKernel::Lanes, Some(CpuSweep::Coloured), xpbd),
+                (CpuKernel::Lanes, Some(CpuSweep::Blocks), xpbd),
             ],
         };
         let on_cpu = device != DeviceChoice::Gpu;
+        if on_cpu {
+            kernels.push((CpuKernel::Lanes, None, Some(newton_of(scene)?)));
+        }
         let mut runs: Vec<KernelRuns> = vec![KernelRuns::default(); kernels.len()];
         for _ in 0..MARKDOWN_RUNS {
-            for (k, (kernel, sweep)) in kernels.iter().enumerate() {
+            for (k, (kernel, sweep, scheme)) in kernels.iter().enumerate() {
                 let choice = |threads| (threads, Some(*kernel), *sweep);
-                runs[k]
-                    .all
-                    .push(measure(scene, device, choice(cpu.0), frames)?);
-                if on_cpu {
-                    let one = measure(scene, device, choice(Some(1)), frames)?;
+                runs[k].all.push(measure_scheme(
+                    scene,
+                    device,
+                    choice(cpu.0),
+                    *scheme,
+                    frames,
+                )?);
+                if on_cpu && *scheme == xpbd {
+                    let one = measure_scheme(scene, device, choice(Some(1)), xpbd, frames)?;
                     runs[k].one.push(one);
                 }
             }
@@ -200,8 +212,13 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
         let share = peak.as_ref().map_or("–".to_string(), |p| {
             format!("{:.1} %", 100.0 * gflops / p.gflops)
         });
+        // A Newton frame has no sweeps: its sweep, flops and peak cells say so.
+        let (sweep, gflops, share) = match r.scheme.as_str() {
+            "XPBD" => (format!("{sweep:.3}"), format!("{gflops:.2}"), share),
+            _ => ("–".into(), "–".into(), "–".into()),
+        };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep:.3} | {scaling} | {gflops:.2} | {share} | {} | {:.1} | {:.2} | {:.1} |\n",
+            "| {} | {} | {} | {} | {} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep} | {scaling} | {gflops} | {share} | {} | {:.1} | {:.2} | {:.1} |\n",
             r.scene,
             r.device,
             r.tets,
@@ -211,7 +228,7 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
             median_of(rs, |r| r.passes_per_frame as f64),
             median_of(rs, |r| r.release_checks_ms_median),
             median_of(rs, |r| r.stress_ms_median),
-            median / unit.unwrap_or(sweep),
+            median / unit.unwrap_or(median_of(rs, |r| r.sweep_ms_median)),
         );
     }
     s += &format!(
@@ -226,14 +243,37 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
     s
 }
 
-/// The measurement behind [`run`].
+/// The implicit scheme the table compares: the scene's own Newton settings, or the
+/// defaults for an XPBD scene.
+fn newton_of(scene: &Path) -> Result<Scheme> {
+    Ok(match crate::scene::load_scene(scene)?.solver.scheme {
+        Scheme::Xpbd => Scheme::Newton(NewtonParams::default()),
+        own => own,
+    })
+}
+
+/// The measurement behind [`run`], with the scene's own scheme.
 pub fn measure(
     scene_path: &Path,
     device: DeviceChoice,
+    cpu: CpuChoice,
+    frames: u32,
+) -> Result<RealtimeResult> {
+    measure_scheme(scene_path, device, cpu, None, frames)
+}
+
+/// [`measure`] with the scheme replaced when `scheme` is given.
+fn measure_scheme(
+    scene_path: &Path,
+    device: DeviceChoice,
     (threads, kernel, sweep): CpuChoice,
+    scheme: Option<Scheme>,
     frames: u32,
 ) -> Result<RealtimeResult> {
     let mut scene = crate::scene::load_scene(scene_path)?;
+    if let Some(s) = scheme {
+        scene.solver.scheme = s;
+    }
     if let Some(k) = kernel {
         scene.solver.cpu_kernel = k;
     }
@@ -242,9 +282,14 @@ pub fn measure(
     }
     let built = crate::scene::build_scene(&scene, scene_path, threads)?;
     let params = built.solver.params();
-    let cpu_kernel = match params.cpu_sweep {
-        CpuSweep::Coloured => format!("{:?}", params.cpu_kernel),
-        CpuSweep::Blocks => format!("{:?}, Blocks", params.cpu_kernel),
+    let cpu_kernel = match (params.scheme, params.cpu_sweep) {
+        (Scheme::Newton(_), _) => "Newton".to_string(),
+        (Scheme::Xpbd, CpuSweep::Coloured) => format!("{:?}", params.cpu_kernel),
+        (Scheme::Xpbd, CpuSweep::Blocks) => format!("{:?}, Blocks", params.cpu_kernel),
+    };
+    let scheme_name = match params.scheme {
+        Scheme::Xpbd => "XPBD",
+        Scheme::Newton(_) => "Newton",
     };
     let cpu_threads = match params.threads {
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
@@ -253,7 +298,7 @@ pub fn measure(
     let nodes = built.solver.mesh().node_count();
     let (tets, substeps, frame_dt) = (
         built.solver.mesh().tet_count(),
-        built.solver.params().substeps,
+        built.solver.params().steps(),
         built.solver.params().frame_dt,
     );
     let stroke = built.tool.as_ref().and_then(|t| t.stroke.clone());
@@ -301,6 +346,7 @@ pub fn measure(
         },
         device: device_name,
         cpu_kernel,
+        scheme: scheme_name.to_string(),
         tets,
         nodes,
         substeps,

@@ -15,6 +15,7 @@ const CONVERGED: NewtonParams = NewtonParams {
     iterations: 6,
     cg_iterations: 200,
     cg_tolerance: 1e-3,
+    gradient_tolerance: 0.0,
     coarse_cell: None,
 };
 
@@ -145,4 +146,26 @@ fn unusable_newton_settings_are_refused() {
         ..SolverParams::default()
     };
     assert!(try_with(seed_pair).contains("RestFree"));
+}
+
+/// Without loads a body at rest stays exactly at rest under Newton (the energy's gradient
+/// is evaluated from `H`, so rest is force-free to the last bit), at ν up to 0.499.
+#[test]
+fn rest_stays_exactly_at_rest() {
+    for nu in [0.0, 0.3, 0.45, 0.499] {
+        let mesh = common::block_mesh(Vec3::ZERO, Vec3::new(0.03, 0.02, 0.01), UVec3::new(6, 4, 2));
+        let params = SolverParams {
+            scheme: Scheme::Newton(NewtonParams::default()),
+            gravity: Vec3::ZERO,
+            threads: 1,
+            ..SolverParams::default()
+        };
+        let mut s = Solver::new(mesh, common::soft(180e3, nu), params).unwrap();
+        s.pin(&[0]);
+        for _ in 0..10 {
+            s.step_frame().unwrap();
+        }
+        let moved = common::max_displacement(&s);
+        assert_eq!(moved, 0.0, "ν = {nu}: moved {moved} m");
+    }
 }

@@ -26,6 +26,9 @@ pub struct NewtonParams {
     /// The conjugate gradient stops when the preconditioned residual falls below this
     /// fraction of its first value.
     pub cg_tolerance: f32,
+    /// Newton stops early once `|∇G|` has fallen to this fraction of its value at the
+    /// step's first iterate (0: always run `iterations`).
+    pub gradient_tolerance: f32,
     /// Edge of the coarse level's cubes, m (`None`: four mean rest edge lengths).
     pub coarse_cell: Option<f32>,
 }
@@ -37,6 +40,7 @@ impl Default for NewtonParams {
             iterations: 5,
             cg_iterations: 100,
             cg_tolerance: 0.01,
+            gradient_tolerance: 0.0,
             coarse_cell: None,
         }
     }
@@ -67,6 +71,12 @@ impl NewtonParams {
             return Err((
                 "scheme.cg_tolerance",
                 format!("must be in (0, 1), got {}", self.cg_tolerance),
+            ));
+        }
+        if !(self.gradient_tolerance.is_finite() && (0.0..1.0).contains(&self.gradient_tolerance)) {
+            return Err((
+                "scheme.gradient_tolerance",
+                format!("must be in [0, 1), got {}", self.gradient_tolerance),
             ));
         }
         if let Some(c) = self.coarse_cell {

@@ -193,7 +193,7 @@ impl NewtonWorkspace {
             } else {
                 0.0
             };
-            if norm == 0.0 {
+            if norm == 0.0 || norm <= self.params.gradient_tolerance as f64 * first {
                 break;
             }
             for (r, g) in self.rhs.iter_mut().zip(&self.gradient) {
