@@ -395,8 +395,8 @@ fn scheme_name(s: &Scheme) -> String {
     match s {
         Scheme::Xpbd => "XPBD".into(),
         Scheme::Newton(p) => format!(
-            "Newton: {} iterations, ≤ {} CG products, tolerance {}",
-            p.iterations, p.cg_iterations, p.cg_tolerance
+            "Newton: {} step(s), ≤ {} iterations (until the gradient is down to {}), ≤ {} CG products to {}",
+            p.steps, p.iterations, p.gradient_tolerance, p.cg_iterations, p.cg_tolerance
         ),
     }
 }

@@ -35,6 +35,19 @@ pub struct RestTet {
     pub volume: f32,
 }
 
+impl RestTet {
+    /// Every tet of `mesh`, in mesh order.
+    pub fn all(mesh: &crate::mesh::TetMesh) -> Vec<RestTet> {
+        (0..mesh.tet_count())
+            .map(|t| RestTet {
+                nodes: mesh.tets[t],
+                dm_inv: mesh.dm_inv[t],
+                volume: mesh.rest_volume[t],
+            })
+            .collect()
+    }
+}
+
 /// `A_c` in 3×3 blocks (lower triangle) and its factor.
 pub struct CoarseSystem {
     /// Block `(row, col)` with row ≥ col → its index in `blocks`.
@@ -283,13 +296,7 @@ mod tests {
         let n = mesh.node_count();
         let free: Vec<bool> = (0..n).map(|i| mesh.rest_positions[i].x > 1e-4).collect();
         let grid = CoarseGrid::new(&mesh.rest_positions, &free, 0.012);
-        let tets: Vec<RestTet> = (0..mesh.tet_count())
-            .map(|t| RestTet {
-                nodes: mesh.tets[t],
-                dm_inv: mesh.dm_inv[t],
-                volume: mesh.rest_volume[t],
-            })
-            .collect();
+        let tets = RestTet::all(&mesh);
         let mass = mesh.lumped_masses(1040.0);
         let sys = CoarseSystem::new(&grid, &tets, &mass, 3600.0, lame()).unwrap();
         let nc = 3 * grid.count;

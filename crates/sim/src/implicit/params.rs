@@ -27,7 +27,7 @@ pub struct NewtonParams {
     /// fraction of its first value.
     pub cg_tolerance: f32,
     /// Newton stops early once `|∇G|` has fallen to this fraction of its value at the
-    /// step's first iterate (0: always run `iterations`).
+    /// step's first iterate (0: always run `iterations`; default 1 %).
     pub gradient_tolerance: f32,
     /// Edge of the coarse level's cubes, m (`None`: four mean rest edge lengths).
     pub coarse_cell: Option<f32>,
@@ -40,7 +40,7 @@ impl Default for NewtonParams {
             iterations: 5,
             cg_iterations: 100,
             cg_tolerance: 0.01,
-            gradient_tolerance: 0.0,
+            gradient_tolerance: 0.01,
             coarse_cell: None,
         }
     }

@@ -100,13 +100,7 @@ impl NewtonWorkspace {
         h: f32,
         params: NewtonParams,
     ) -> Result<Self, CoarseError> {
-        let tets: Vec<RestTet> = (0..mesh.tet_count())
-            .map(|t| RestTet {
-                nodes: mesh.tets[t],
-                dm_inv: mesh.dm_inv[t],
-                volume: mesh.rest_volume[t],
-            })
-            .collect();
+        let tets = RestTet::all(mesh);
         let cell = params
             .coarse_cell
             .unwrap_or_else(|| 4.0 * mesh.mean_edge_length());
