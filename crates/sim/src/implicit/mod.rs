@@ -8,6 +8,7 @@ mod coarse_grid;
 mod coarse_system;
 mod params;
 mod pcg;
+mod product_lanes;
 mod tet_tangent;
 mod workspace;
 

@@ -58,6 +58,12 @@ impl TetTangent {
         *df * self.mu + self.cof * (self.c * dj) + cofactor_differential(&self.f, df) * self.s3
     }
 
+    /// `(F, cof F, μ, c, s₃)`: what the eight-lane product ([`super::product_lanes`]) packs.
+    #[inline]
+    pub(crate) fn parts(&self) -> (Mat3, Mat3, f32, f32, f32) {
+        (self.f, self.cof, self.mu, self.c, self.s3)
+    }
+
     /// `∂²E/∂x_a²` of a tet of volume `volume` for its node with shape gradient `b`,
     /// with `c` clamped at zero (a positive definite block: the block Jacobi part of the
     /// preconditioner). The `dcof` term contracts to zero with `b` on both sides.

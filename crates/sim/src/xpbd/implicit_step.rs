@@ -4,9 +4,9 @@
 //! same damping and the release checks on the same simulation-time schedule (PHYSICS.md
 //! §1.4), so stress, release and contact are those of the XPBD scheme.
 
-use super::SolverError;
 use super::release_schedule::release_checks;
 use super::solver::{NodeKind, Solver};
+use super::{CpuKernel, SolverError};
 use crate::implicit::{NewtonParams, NewtonWorkspace};
 
 impl Solver {
@@ -21,7 +21,9 @@ impl Solver {
         let h = self.params.frame_dt / n as f32;
         let free: Vec<bool> = self.kind.iter().map(|k| *k == NodeKind::Free).collect();
         if self.newton.is_none() {
-            let ws = NewtonWorkspace::new(&self.mesh, &self.mass, &free, self.lame, h, p)?;
+            // The SIMD product unless the scalar reference kernel is asked for.
+            let lanes = self.params.cpu_kernel != CpuKernel::Scalar;
+            let ws = NewtonWorkspace::new(&self.mesh, &self.mass, &free, self.lame, (h, lanes), p)?;
             self.newton = Some(ws);
         }
         let checks = release_checks(self.time, h, n, self.params.release_interval);

@@ -6,9 +6,9 @@ mod frame;
 mod implicit_step;
 mod lane;
 #[cfg(target_arch = "x86_64")]
-mod lane_avx;
+pub(crate) mod lane_avx;
 mod lane_pass;
-mod lanes;
+pub(crate) mod lanes;
 mod neo_hookean;
 mod params;
 mod release_schedule;

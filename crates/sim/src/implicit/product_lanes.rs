@@ -1,0 +1,150 @@
+//! The Hessian product of [`super::TetTangent`] eight tets at a time in SIMD lanes, with
+//! the XPBD lanes' algebra (`crate::xpbd::lanes`): in one AVX register per value where
+//! the CPU has AVX2 (detected at run time, so the portable build uses it), else in
+//! `wide::f32x8`. The same operations in the same order as the scalar product
+//! (`workspace.rs`, `Hessian::scalar_products`), which stays the reference
+//! (`cpu_kernel: Scalar`) and is tested equal to it up to rounding.
+
+use glam::{Mat3, Vec3};
+
+use super::coarse_system::RestTet;
+use super::tet_tangent::TetTangent;
+use crate::xpbd::lanes::{LANES, Lane, M3, V3};
+
+/// Eight tets' rest data: nodes, `Dm⁻¹` and `V b_a` for a = 1, 2, 3 (lanes past `count`
+/// are padding).
+#[derive(Debug, Clone, Copy)]
+pub struct RestLanes {
+    nodes: [[u32; 4]; LANES],
+    count: usize,
+    dm_inv: [Mat3; LANES],
+    vb: [[Vec3; LANES]; 3],
+}
+
+/// Eight tets' tangents at the current iterate: `F`, `cof F`, μ, c, s₃.
+#[derive(Debug, Clone, Copy)]
+pub struct TangentLanes {
+    f: [Mat3; LANES],
+    cof: [Mat3; LANES],
+    scalars: [[f32; LANES]; 3],
+}
+
+/// The rest data of `tets` (shape gradients `b`) in chunks of eight.
+pub fn rest_lanes(tets: &[RestTet], b: &[[Vec3; 4]]) -> Vec<RestLanes> {
+    tets.chunks(LANES)
+        .zip(b.chunks(LANES))
+        .map(|(t, b)| {
+            let mut r = RestLanes {
+                nodes: [[0; 4]; LANES],
+                count: t.len(),
+                dm_inv: [Mat3::ZERO; LANES],
+                vb: [[Vec3::ZERO; LANES]; 3],
+            };
+            for k in 0..t.len() {
+                r.nodes[k] = t[k].nodes;
+                r.dm_inv[k] = t[k].dm_inv;
+                for a in 0..3 {
+                    r.vb[a][k] = b[k][a + 1] * t[k].volume;
+                }
+            }
+            r
+        })
+        .collect()
+}
+
+/// The tangents `t(0..n)` (n ≤ 8) in lanes; the lanes past `n` are unused.
+pub fn tangent_lanes(n: usize, t: impl Fn(usize) -> TetTangent) -> TangentLanes {
+    let mut out = TangentLanes {
+        f: [Mat3::IDENTITY; LANES],
+        cof: [Mat3::IDENTITY; LANES],
+        scalars: [[0.0; LANES]; 3],
+    };
+    for k in 0..n {
+        let (f, cof, mu, c, s3) = t(k).parts();
+        (out.f[k], out.cof[k]) = (f, cof);
+        (out.scalars[0][k], out.scalars[1][k], out.scalars[2][k]) = (mu, c, s3);
+    }
+    out
+}
+
+/// The four nodal forces `V dP[dF] b_a` of each tet of the chunk for the direction `p`
+/// (zero where `live` is false), into `out` (one entry per tet of the chunk).
+pub fn product(
+    rest: &RestLanes,
+    tan: &TangentLanes,
+    live: &[bool],
+    p: &[Vec3],
+    out: &mut [[Vec3; 4]],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2.
+        return unsafe { product_avx2(rest, tan, live, p, out) };
+    }
+    product_in::<wide::f32x8>(rest, tan, live, p, out);
+}
+
+/// [`product_in`] with AVX lanes, compiled for AVX2.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2")]
+unsafe fn product_avx2(
+    rest: &RestLanes,
+    tan: &TangentLanes,
+    live: &[bool],
+    p: &[Vec3],
+    out: &mut [[Vec3; 4]],
+) {
+    product_in::<crate::xpbd::lane_avx::Avx>(rest, tan, live, p, out);
+}
+
+/// The product in lanes of type `L`, compiled into its caller (loops written out: an
+/// out-of-line `map` would be compiled without the caller's AVX).
+#[inline(always)]
+fn product_in<L: Lane>(
+    rest: &RestLanes,
+    tan: &TangentLanes,
+    live: &[bool],
+    p: &[Vec3],
+    out: &mut [[Vec3; 4]],
+) {
+    let mut d = [[Vec3::ZERO; LANES]; 4];
+    for k in 0..rest.count {
+        for a in 0..4 {
+            d[a][k] = p[rest.nodes[k][a] as usize];
+        }
+    }
+    let d0 = V3::<L>::gather(&d[0]);
+    let ds = M3 {
+        c0: V3::gather(&d[1]) - d0,
+        c1: V3::gather(&d[2]) - d0,
+        c2: V3::gather(&d[3]) - d0,
+    };
+    let df = ds.mul_mat(&M3::gather(&rest.dm_inv));
+    let (f, cof) = (M3::<L>::gather(&tan.f), M3::<L>::gather(&tan.cof));
+    let (mu, c, s3) = (
+        L::new(tan.scalars[0]),
+        L::new(tan.scalars[1]),
+        L::new(tan.scalars[2]),
+    );
+    let dj = cof.c0.dot(df.c0) + cof.c1.dot(df.c1) + cof.c2.dot(df.c2);
+    let dcof = M3 {
+        c0: df.c1.cross(f.c2) + f.c1.cross(df.c2),
+        c1: df.c2.cross(f.c0) + f.c2.cross(df.c0),
+        c2: df.c0.cross(f.c1) + f.c0.cross(df.c1),
+    };
+    let dp = df * mu + cof * (c * dj) + dcof * s3;
+    let f1 = dp.mul_vec(V3::gather(&rest.vb[0]));
+    let f2 = dp.mul_vec(V3::gather(&rest.vb[1]));
+    let f3 = dp.mul_vec(V3::gather(&rest.vb[2]));
+    let f0 = -(f1 + f2 + f3);
+    for k in 0..rest.count {
+        out[k] = if live[k] {
+            [f0.lane(k), f1.lane(k), f2.lane(k), f3.lane(k)]
+        } else {
+            [Vec3::ZERO; 4]
+        };
+    }
+}
