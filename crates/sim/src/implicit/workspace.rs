@@ -43,7 +43,8 @@ pub struct NewtonReport {
     pub negative_curvature: u32,
     /// Step halvings of the line search.
     pub halvings: u32,
-    /// `|∇G|` at the end over `|∇G|` at the start of the step (free nodes, 2-norm).
+    /// `|∇G|` where the last iteration started (or where the gradient stop ended the step)
+    /// over `|∇G|` at the step's first iterate (free nodes, 2-norm).
     pub gradient_ratio: f32,
 }
 
