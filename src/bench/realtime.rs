@@ -213,9 +213,10 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
             format!("{:.1} %", 100.0 * gflops / p.gflops)
         });
         // A Newton frame has no sweeps: its sweep, flops and peak cells say so.
-        let (sweep, gflops, share) = match r.scheme.as_str() {
-            "XPBD" => (format!("{sweep:.3}"), format!("{gflops:.2}"), share),
-            _ => ("–".into(), "–".into(), "–".into()),
+        let (sweep, gflops, share) = if r.scheme == Scheme::Xpbd.name() {
+            (format!("{sweep:.3}"), format!("{gflops:.2}"), share)
+        } else {
+            ("–".into(), "–".into(), "–".into())
         };
         s += &format!(
             "| {} | {} | {} | {} | {} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep} | {scaling} | {gflops} | {share} | {} | {:.1} | {:.2} | {:.1} |\n",
@@ -283,14 +284,11 @@ fn measure_scheme(
     let built = crate::scene::build_scene(&scene, scene_path, threads)?;
     let params = built.solver.params();
     let cpu_kernel = match (params.scheme, params.cpu_sweep) {
-        (Scheme::Newton(_), _) => "Newton".to_string(),
+        (Scheme::Newton(_), _) => params.scheme.name().to_string(),
         (Scheme::Xpbd, CpuSweep::Coloured) => format!("{:?}", params.cpu_kernel),
         (Scheme::Xpbd, CpuSweep::Blocks) => format!("{:?}, Blocks", params.cpu_kernel),
     };
-    let scheme_name = match params.scheme {
-        Scheme::Xpbd => "XPBD",
-        Scheme::Newton(_) => "Newton",
-    };
+    let scheme = params.scheme.name().to_string();
     let cpu_threads = match params.threads {
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
         n => n,
@@ -346,7 +344,7 @@ fn measure_scheme(
         },
         device: device_name,
         cpu_kernel,
-        scheme: scheme_name.to_string(),
+        scheme,
         tets,
         nodes,
         substeps,

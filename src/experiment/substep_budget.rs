@@ -267,9 +267,7 @@ fn row(
 struct SceneBudget {
     /// The fewest substeps the stability bound allows (κ ≤ 1 at the worst tet).
     bound: u32,
-    /// The scene's own substeps.
-    own: u32,
-    /// The scene's solver settings.
+    /// The scene's solver settings (its own substeps among them).
     params: incise_sim::SolverParams,
     /// Frames of the scene's whole duration.
     frames: u32,
@@ -277,13 +275,12 @@ struct SceneBudget {
     rest: Vec<Vec3>,
 }
 
-/// The stability bound, own substeps, duration in frames and rest state of a scene.
+/// The stability bound, solver settings, duration in frames and rest state of a scene.
 fn scene_budget(scene_path: &Path) -> Result<SceneBudget> {
     let scene = load_scene(scene_path)?;
     let s = build_scene(&scene, scene_path, None)?.solver;
     Ok(SceneBudget {
         bound: s.fewest_stable_substeps().max(1),
-        own: s.params().substeps,
         params: s.params().clone(),
         frames: (scene.duration as f64 / s.params().frame_dt as f64 - 1e-6).ceil() as u32,
         rest: s.mesh().rest_positions.clone(),
@@ -295,12 +292,12 @@ fn scene_budget(scene_path: &Path) -> Result<SceneBudget> {
 pub fn measure(scene_path: &Path, frames: Option<u32>) -> Result<Vec<BudgetRow>> {
     let SceneBudget {
         bound,
-        own,
         frames: whole,
         rest,
         params,
     } = scene_budget(scene_path)?;
     let frames = frames.unwrap_or(whole);
+    let own = params.substeps;
     let reference = REFERENCE_SUBSTEPS.max(3 * own);
     let ref_state = run_at(scene_path, Run::Xpbd(reference), frames)
         .with_context(|| format!("{}: the reference run", scene_path.display()))?;
@@ -393,10 +390,15 @@ fn table_row(r: &BudgetRow) -> String {
 /// The scheme as a table cell: `XPBD`, or `Newton` with its iterations and CG products.
 fn scheme_name(s: &Scheme) -> String {
     match s {
-        Scheme::Xpbd => "XPBD".into(),
+        Scheme::Xpbd => s.name().into(),
         Scheme::Newton(p) => format!(
-            "Newton: {} step(s), ≤ {} iterations (until the gradient is down to {}), ≤ {} CG products to {}",
-            p.steps, p.iterations, p.gradient_tolerance, p.cg_iterations, p.cg_tolerance
+            "{}: {} step(s), ≤ {} iterations (until the gradient is down to {}), ≤ {} CG products to {}",
+            s.name(),
+            p.steps,
+            p.iterations,
+            p.gradient_tolerance,
+            p.cg_iterations,
+            p.cg_tolerance
         ),
     }
 }

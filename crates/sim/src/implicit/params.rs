@@ -13,6 +13,16 @@ pub enum Scheme {
     Newton(NewtonParams),
 }
 
+impl Scheme {
+    /// `"XPBD"` or `"Newton"`, as tables and reports name it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Scheme::Xpbd => "XPBD",
+            Scheme::Newton(_) => "Newton",
+        }
+    }
+}
+
 /// Settings of the implicit scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

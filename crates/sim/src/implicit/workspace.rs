@@ -23,6 +23,7 @@ use super::tet_tangent::TetTangent;
 use crate::material::Lame;
 use crate::mesh::TetMesh;
 use crate::vbd::{energy_density, piola, shape_gradients};
+use crate::xpbd::lanes::LANES;
 use crate::xpbd::{Strain, displacement_gradient};
 
 /// Items per rayon task.
@@ -113,7 +114,7 @@ impl NewtonWorkspace {
         let grid = CoarseGrid::new(&mesh.rest_positions, free, cell);
         let inv_h2 = 1.0 / (h * h);
         let coarse = CoarseSystem::new(&grid, &tets, mass, inv_h2, lame)?;
-        let (inc_offsets, inc) = incidence(mesh);
+        let (inc_offsets, inc) = (mesh.node_tet_offsets.clone(), mesh.node_corners());
         let n = mesh.node_count();
         let rest = TetEval {
             forces: [Vec3::ZERO; 4],
@@ -298,7 +299,7 @@ impl Hessian {
         if let Some((_, tangents)) = &mut self.lanes {
             let evals = &self.evals;
             for_each(parallel, tangents, |c, t| {
-                let chunk = &evals[c * 8..(c * 8 + 8).min(evals.len())];
+                let chunk = &evals[c * LANES..(c * LANES + LANES).min(evals.len())];
                 *t = tangent_lanes(chunk.len(), |k| chunk[k].tangent);
             });
         }
@@ -362,17 +363,17 @@ impl Hessian {
     ) {
         if let Some((rest, tangents)) = &self.lanes {
             let run = |(c, out): (usize, &mut [[Vec3; 4]])| {
-                let live = &live[c * 8..(c * 8 + out.len())];
+                let live = &live[c * LANES..(c * LANES + out.len())];
                 product(&rest[c], &tangents[c], live, p, out);
             };
             if parallel {
                 self.products
-                    .par_chunks_mut(8)
+                    .par_chunks_mut(LANES)
                     .enumerate()
-                    .with_min_len(CHUNK / 8)
+                    .with_min_len(CHUNK / LANES)
                     .for_each(run);
             } else {
-                self.products.chunks_mut(8).enumerate().for_each(run);
+                self.products.chunks_mut(LANES).enumerate().for_each(run);
             }
         } else {
             self.scalar_products(p, live, parallel);
@@ -456,28 +457,6 @@ fn for_each<T: Send>(parallel: bool, out: &mut [T], f: impl Fn(usize, &mut T) + 
     }
 }
 
-/// Per node, the (tet, corner) pairs it belongs to, in CSR form.
-fn incidence(mesh: &TetMesh) -> (Vec<u32>, Vec<(u32, u8)>) {
-    let mut count = vec![0u32; mesh.node_count() + 1];
-    for tet in &mesh.tets {
-        for &n in tet {
-            count[n as usize + 1] += 1;
-        }
-    }
-    for i in 0..mesh.node_count() {
-        count[i + 1] += count[i];
-    }
-    let mut fill = count.clone();
-    let mut inc = vec![(0u32, 0u8); count[mesh.node_count()] as usize];
-    for (t, tet) in mesh.tets.iter().enumerate() {
-        for (a, &n) in tet.iter().enumerate() {
-            inc[fill[n as usize] as usize] = (t as u32, a as u8);
-            fill[n as usize] += 1;
-        }
-    }
-    (count, inc)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -527,7 +506,7 @@ mod tests {
             glam::UVec3::new(7, 3, 2),
         );
         let mesh = TetMesh::from_raw(raw).unwrap().0;
-        assert_ne!(mesh.tet_count() % 8, 0);
+        assert_ne!(mesh.tet_count() % LANES, 0);
         let free: Vec<bool> = mesh.rest_positions.iter().map(|p| p.x > 1e-4).collect();
         let lame = Lame {
             mu: 6.2e4,

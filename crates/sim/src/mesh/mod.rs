@@ -69,6 +69,20 @@ impl TetMesh {
         self.tets.len()
     }
 
+    /// For each entry of the node→tet lists (node after node, as
+    /// [`TetMesh::tets_of_node`] gives them; offsets [`TetMesh::node_tet_offsets`]), the
+    /// tet and the node's corner in it (0–3).
+    pub fn node_corners(&self) -> Vec<(u32, u8)> {
+        (0..self.node_count())
+            .flat_map(|i| {
+                self.tets_of_node(i).iter().map(move |&t| {
+                    let corner = self.tets[t as usize].iter().position(|&k| k as usize == i);
+                    (t, corner.unwrap_or(0) as u8)
+                })
+            })
+            .collect()
+    }
+
     /// Tets incident to node `i`.
     pub fn tets_of_node(&self, i: usize) -> &[u32] {
         let a = self.node_tet_offsets[i] as usize;

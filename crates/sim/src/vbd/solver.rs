@@ -144,23 +144,18 @@ impl VbdSolver {
                 b: shape_gradients(&mesh.dm_inv[t]),
             })
             .collect();
-        let mut inc_offsets = vec![0u32; n + 1];
-        let mut inc = Vec::with_capacity(4 * tets.len());
+        let (inc_offsets, inc) = (mesh.node_tet_offsets.clone(), mesh.node_corners());
         let mut max_step = vec![f32::INFINITY; n];
         let frac = params.max_step_fraction;
-        for i in 0..n {
+        for (i, step) in max_step.iter_mut().enumerate() {
             for &t in mesh.tets_of_node(i) {
-                let nodes = mesh.tets[t as usize];
-                let a = nodes.iter().position(|&k| k as usize == i).unwrap_or(0);
-                inc.push((t, a as u8));
-                for &k in &nodes {
+                for &k in &mesh.tets[t as usize] {
                     if k as usize != i {
                         let e = (mesh.rest_positions[k as usize] - mesh.rest_positions[i]).length();
-                        max_step[i] = max_step[i].min(frac * e);
+                        *step = step.min(frac * e);
                     }
                 }
             }
-            inc_offsets[i + 1] = inc.len() as u32;
         }
         let (color, ncolors) = greedy_vertex_colors(n, &mesh.tets);
         let mass = mesh.lumped_masses(material.density);

@@ -128,16 +128,18 @@ impl Solver {
             .iter()
             .map(|&m| if m > 0.0 { 1.0 / m } else { 0.0 })
             .collect();
-        let (kappa, tet) = stiffness_number(&mesh, &inv_mass, lame, params.substep());
         // Implicit Euler has no step bound; only the XPBD small steps do.
-        if params.scheme == Scheme::Xpbd && kappa > MAX_STIFFNESS_NUMBER {
-            return Err(SolverError::Unstable {
-                h_ms: params.substep() * 1e3,
-                tet,
-                kappa,
-                max: MAX_STIFFNESS_NUMBER,
-                needed: substeps_needed(kappa, params.substeps),
-            });
+        if params.scheme == Scheme::Xpbd {
+            let (kappa, tet) = stiffness_number(&mesh, &inv_mass, lame, params.substep());
+            if kappa > MAX_STIFFNESS_NUMBER {
+                return Err(SolverError::Unstable {
+                    h_ms: params.substep() * 1e3,
+                    tet,
+                    kappa,
+                    max: MAX_STIFFNESS_NUMBER,
+                    needed: substeps_needed(kappa, params.substeps),
+                });
+            }
         }
         let pool = match params.threads {
             1 => None,
