@@ -7,6 +7,7 @@
 use std::path::PathBuf;
 
 use egui::{Color32, Pos2, Rect, Stroke, Vec2};
+use incise_sim::contact::CutZone;
 use incise_xr::Overlays;
 use incise_xr::colour_map::turbo;
 
@@ -346,6 +347,16 @@ impl Panel {
                     .text("cut σvM (Pa)"),
             );
             d.cut_threshold = Some(t);
+            let mut edge = d.cut_zone != CutZone::Anywhere;
+            let r = ui
+                .checkbox(&mut edge, "only along the blade's edge")
+                .on_hover_text(
+                    "off: tets release wherever the stress passes the threshold (tearing)",
+                );
+            if r.changed() {
+                d.cut_zone = if edge { d.edge_zone } else { CutZone::Anywhere };
+                done = true;
+            }
         } else {
             d.cut_threshold = None;
         }

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use glam::Vec3;
+use incise_sim::contact::CutZone;
 use incise_sim::grab::Grab;
 use incise_sim::skin::Skin;
 use incise_sim::xpbd::FrameStats;
@@ -15,6 +16,7 @@ use incise_xr::RenderDevice;
 
 use super::hand_tool::HandTool;
 use crate::pictures::screenshots::{default_camera, place_on};
+use crate::scene::hand_tool::edge_zone;
 use crate::scene::{Scene, ToolDriver, build_scene_driven, load_scene};
 use crate::sim_body::{Body, DeviceChoice};
 
@@ -29,6 +31,12 @@ pub struct LiveParams {
     pub damping: f32,
     /// von Mises cut threshold, Pa (`None`: no cutting).
     pub cut_threshold: Option<f32>,
+    /// Where the cut criterion may release tets (the scene's own unless the panel's
+    /// switch changed it).
+    pub cut_zone: CutZone,
+    /// The zone the panel's "only along the blade's edge" switch gives (the scene's own
+    /// `NearEdge`, else [`edge_zone`] for this mesh; not editable).
+    pub edge_zone: CutZone,
     /// Substeps per frame.
     pub substeps: u32,
     /// The Poisson ratios the scene's constraint pair can represent (not editable).
@@ -94,6 +102,11 @@ impl Session {
             poisson_ratio: built.material.poisson_ratio,
             damping: p.damping,
             cut_threshold: p.release_threshold,
+            cut_zone: p.cut_zone,
+            edge_zone: match p.cut_zone {
+                CutZone::Anywhere => edge_zone(built.solver.mesh().mean_edge_length()),
+                own => own,
+            },
             substeps: p.substeps,
             poisson_range: p.poisson_range(),
         };
@@ -203,6 +216,7 @@ impl Session {
         let mut sp = cur.params().clone();
         sp.damping = self.params.damping;
         sp.release_threshold = self.params.cut_threshold;
+        sp.cut_zone = self.params.cut_zone;
         sp.substeps = self.params.substeps;
         let mesh = cur.mesh().clone();
         let rest = mesh.rest_positions.clone();

@@ -47,8 +47,7 @@ pub enum ToolDriver {
     /// The scene's own stroke (or no tool at all).
     Scene,
     /// A hand: the preview's mouse or a recorded stroke. Every scene gets a tool (the
-    /// built-in No. 10 when it names none) and a cutting scene without a cut zone gets one
-    /// along the edge (see `hand_tool`).
+    /// built-in No. 10 when it names none); the scene's cut zone stays (see `hand_tool`).
     Hand,
 }
 
@@ -91,9 +90,6 @@ pub fn build_scene_driven(
     params.release_threshold = scene.cutting.as_ref().map(|c| c.von_mises_threshold);
     if let Some(t) = threads {
         params.threads = t;
-    }
-    if driver == ToolDriver::Hand {
-        super::hand_tool::edge_cut_zone(&mut params, mesh.mean_edge_length());
     }
     let rest = mesh.rest_positions.clone();
     let mut solver =

@@ -58,8 +58,8 @@ pub fn open(
             path.display()
         );
     }
-    // A recorded stroke is a hand's: the scene gets the tool and cut zone the preview
-    // gave it (scene/hand_tool.rs), so the replay is the same physics.
+    // A recorded stroke is a hand's: the scene gets the tool the preview gave it
+    // (scene/hand_tool.rs), so the replay is the same physics.
     let driver = match opts.stroke {
         Some(_) => ToolDriver::Hand,
         None => ToolDriver::Scene,
