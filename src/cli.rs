@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+use crate::bench::BenchCase;
+use crate::mesh_cmd::GenKind;
 use crate::pictures::screenshots::{ImageSize, OverlayArg};
 use crate::sim_body::DeviceChoice;
 use crate::xr::sim_mode::SimChoice;
@@ -397,19 +399,6 @@ pub enum MeshCommand {
     },
 }
 
-/// Procedural meshes available from the CLI.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum GenKind {
-    /// Nakao 2003 plate, 16 × 16 × 0.4 cm.
-    Plate,
-    /// ≈34k-tet curved intestine with a finer skin.
-    Intestine,
-    /// 10 × 2 × 2 cm block, 10 × 2 × 2 cells.
-    Block,
-    /// 20 cm × 2 cm × 2 cm beam, 40 × 4 × 4 cells.
-    Beam,
-}
-
 /// Which CPU kernel projects the tets (`incise bench realtime --cpu-kernel`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum KernelChoice {
@@ -463,17 +452,6 @@ pub enum BenchTarget {
     /// The `--scene` of any method through its body's script: ms per frame, nodes and
     /// tets, and a Nakao body's localisation levels and loop split (`--frames` frames).
     Scene,
-}
-
-/// Benchmark case selection.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum BenchCase {
-    /// Plate and intestine.
-    All,
-    /// The Nakao plate.
-    Plate,
-    /// The 34k-tet intestine.
-    Intestine,
 }
 
 /// A loop rate in Hz: finite, above 0 and at most 100 kHz.

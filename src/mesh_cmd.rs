@@ -3,11 +3,23 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use clap::ValueEnum;
 use incise_sim::mesh::quality::assess;
 use incise_sim::skin::Skin;
 use incise_sim::{TetMesh, generate, io};
 
-use crate::cli::GenKind;
+/// Procedural meshes available from the CLI.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum GenKind {
+    /// Nakao 2003 plate, 16 × 16 × 0.4 cm.
+    Plate,
+    /// ≈34k-tet curved intestine with a finer skin.
+    Intestine,
+    /// 10 × 2 × 2 cm block, 10 × 2 × 2 cells.
+    Block,
+    /// 20 cm × 2 cm × 2 cm beam, 40 × 4 × 4 cells.
+    Beam,
+}
 
 /// Load `file`, print counts and quality; an unreadable mesh or one with degenerate tets
 /// is an error (exit 1) naming the file and line or the tet.

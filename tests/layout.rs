@@ -181,6 +181,76 @@ fn no_file_imports_a_file_that_imports_it() {
     }
 }
 
+/// The app's top-level modules from the floor up: a module imports only modules below it
+/// (issue 32: types live on the floor where they are used, presentation above the bodies).
+const APP_LAYERS: &[&str] = &[
+    "provenance",
+    "progress",
+    "interrupt",
+    "scene",
+    "report",
+    "sim_body",
+    "pictures",
+    "run",
+    "exercise",
+    "experiment",
+    "compare",
+    "mesh_cmd",
+    "bench",
+    "xr",
+    "preview",
+    "cli",
+];
+
+/// Imports from a top-level module to one at or above its own layer in `layers` (the
+/// crate root, not in `layers`, sits on top), as "file -> imported file" lines.
+fn upward_imports(files: &BTreeMap<Module, String>, layers: &[&str]) -> Vec<String> {
+    let layer = |m: &Module| match m.first() {
+        None => Some(layers.len()),
+        Some(top) => layers.iter().position(|l| l == top),
+    };
+    let mut out = Vec::new();
+    for (from, targets) in imports(files) {
+        let lf = layer(&from)
+            .unwrap_or_else(|| panic!("{}: no layer", show(std::slice::from_ref(&from))));
+        for to in targets {
+            let lt = layer(&to)
+                .unwrap_or_else(|| panic!("{}: no layer", show(std::slice::from_ref(&to))));
+            if lt > lf || (lt == lf && from.first() != to.first()) {
+                out.push(show(&[from.clone(), to]));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn no_app_module_imports_one_above_it() {
+    let files = modules(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"));
+    let up = upward_imports(&files, APP_LAYERS);
+    assert!(
+        up.is_empty(),
+        "imports that run up the layers ({}):\n{}",
+        APP_LAYERS.join(" < "),
+        up.join("\n")
+    );
+}
+
+#[test]
+fn an_upward_import_is_found() {
+    let files: BTreeMap<Module, String> = [
+        (vec![], "mod a;\nmod b;".to_string()),
+        (vec!["a".into()], "use crate::b::Thing;".into()),
+        (vec!["b".into()], "fn f() {}".into()),
+    ]
+    .into();
+    assert_eq!(upward_imports(&files, &["b", "a"]), Vec::<String>::new());
+    assert_eq!(
+        upward_imports(&files, &["a", "b"]),
+        vec!["a -> b".to_string()]
+    );
+}
+
 #[test]
 fn a_circle_of_imports_is_found() {
     let files: BTreeMap<Module, String> = [

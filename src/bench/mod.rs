@@ -11,14 +11,25 @@ pub mod soak;
 use std::time::Instant;
 
 use anyhow::Result;
+use clap::ValueEnum;
 use incise_sim::generate::{self, IntestineParams};
 use incise_sim::selection::NodeSelection;
 use incise_sim::xpbd::{stiffness_number, substeps_needed};
 use incise_sim::{Material, RawMesh, Solver, SolverParams, TetMesh};
 use serde::Serialize;
 
-use crate::cli::BenchCase;
 use crate::sim_body::{Body, DeviceChoice};
+
+/// Benchmark case selection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BenchCase {
+    /// Plate and intestine.
+    All,
+    /// The Nakao plate.
+    Plate,
+    /// The 34k-tet intestine.
+    Intestine,
+}
 
 /// Substeps per benchmark frame.
 pub const BENCH_SUBSTEPS: u32 = 10;

@@ -15,7 +15,7 @@ use incise_sim::{Material, Solver, SolverParams, TetMesh};
 use incise_xr::{Camera, OffscreenRenderer, RenderDevice, RenderSettings, UncutBody, View};
 use serde::Serialize;
 
-use crate::cli::BenchCase;
+use super::BenchCase;
 use crate::sim_body::{DeviceChoice, auto_device};
 
 /// The GPU body's material: it is not stepped (only its buffers are read); soft enough

@@ -13,8 +13,9 @@ use serde::Serialize;
 use crate::bench::BenchOutput;
 use crate::bench::soak::percentile;
 use crate::report::localisation::LocalisationInfo;
+use crate::scene::Method;
 use crate::scene::load_scene;
-use crate::sim_body::{DeviceChoice, Method, OpenOptions, ToolInput, open};
+use crate::sim_body::{DeviceChoice, OpenOptions, ToolInput, open};
 
 /// The figures of one scene's frames.
 #[derive(Debug, Clone, Serialize)]

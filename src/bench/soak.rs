@@ -19,9 +19,10 @@ use anyhow::{Context, Result, anyhow, bail};
 use serde::Serialize;
 
 use crate::report::{EdgeFrameStats, FrameData};
+use crate::scene::Method;
 use crate::scene::{ModelChoice, Scene, load_scene};
 use crate::sim_body::xpbd_device::gpu_context;
-use crate::sim_body::{DeviceChoice, Method, OpenOptions, Outcome, ToolInput, open};
+use crate::sim_body::{DeviceChoice, OpenOptions, Outcome, ToolInput, open};
 
 /// Growth of the resident memory that is not counted however large relatively, KiB: the
 /// allocator settling. A 6 s soak of the 0.3 s Nakao plate (56 cuts of a 12 MB process)

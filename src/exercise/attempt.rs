@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
-use super::decal::PlanDecal;
 use super::history::{self, HistoryEntry};
 use super::load::{LoadedExercise, load_exercise};
 use super::metrics::{self, ToolFrame};
@@ -82,7 +81,7 @@ pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
         inject_nan_at: None,
         // The plan is drawn on XPBD bodies (a Nakao cut remodels the tets it is laid in).
         screenshot_decal: matches!(ex.scene.model, ModelChoice::Xpbd)
-            .then(|| PlanDecal::new(&ex.plan, &ex.mesh)),
+            .then(|| ex.plan.decal(&ex.mesh)),
     })
     .with_context(|| format!("{}: running the attempt", opts.exercise.display()))?;
     let report = outcome.report;

@@ -13,9 +13,10 @@ use anyhow::{Context, Result, anyhow, bail};
 use incise_xr::RgbaImage;
 
 use super::{
-    Attempt, CutImages, LoadedExercise, PlanDecal, ReferenceStyle, Standing, ToolFrame,
-    load_exercise, read_history, reference_stroke, render_card, save_attempt, score_attempt,
+    Attempt, CutImages, LoadedExercise, ReferenceStyle, Standing, ToolFrame, load_exercise,
+    read_history, reference_stroke, render_card, save_attempt, score_attempt,
 };
+use crate::pictures::plan_decal::PlanDecal;
 use crate::pictures::screenshots::{ImageSize, Screenshots};
 use crate::pictures::view_pictures::ViewPictures;
 use crate::sim_body::recorded::RecordedBody;
@@ -143,7 +144,7 @@ impl<P> LiveExercise<P> {
     /// Load the exercise at `path` and lay its plan on the mesh.
     pub fn open(path: &Path) -> Result<LiveExercise<P>> {
         let exercise = load_exercise(path)?;
-        let decal = PlanDecal::new(&exercise.plan, &exercise.mesh);
+        let decal = exercise.plan.decal(&exercise.mesh);
         Ok(LiveExercise {
             exercise,
             decal,

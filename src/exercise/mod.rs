@@ -6,7 +6,6 @@
 mod attempt;
 mod band;
 mod cut_reading;
-mod decal;
 mod history;
 pub mod live;
 mod load;
@@ -23,7 +22,6 @@ mod result_card;
 mod score;
 
 pub use attempt::{Attempt, ExerciseOptions, run_exercise, save_attempt, score_attempt};
-pub use decal::{DECAL_COLOUR, DECAL_SPACING, DECAL_WIDTH, PlanDecal};
 pub use history::{
     HistoryEntry, append as append_history, read as read_history, table as history_table, utc_now,
 };

@@ -7,6 +7,8 @@
 use glam::{DVec3, Vec3};
 use incise_sim::TetMesh;
 
+use crate::pictures::plan_decal::{MarkPoint, PlanDecal};
+
 /// Largest spacing of the plan samples, m.
 const SAMPLE_SPACING: f64 = 0.0005;
 
@@ -101,6 +103,20 @@ pub struct OffSurface {
 }
 
 impl Plan {
+    /// The plan drawn on `mesh` like a marker line (its samples embedded in the rest
+    /// tets, see [`PlanDecal`]).
+    pub fn decal(&self, mesh: &TetMesh) -> PlanDecal {
+        let marks: Vec<MarkPoint> = self
+            .samples
+            .iter()
+            .map(|s| MarkPoint {
+                point: s.point.as_vec3(),
+                normal: s.normal.as_vec3(),
+            })
+            .collect();
+        PlanDecal::new(&marks, self.spacing(), mesh)
+    }
+
     /// Project `points` onto `surface` (refusing any farther than `tolerance`) and sample
     /// the polyline through them at ≤ 0.5 mm, each sample projected again for its normal.
     pub fn new(points: &[Vec3], surface: &RestSurface, tolerance: f64) -> Result<Plan, OffSurface> {

@@ -5,7 +5,7 @@ use serde::Serialize;
 use super::metrics::Metrics;
 use super::model::{PassThresholds, Tolerance};
 use super::score::Verdict;
-use crate::sim_body::Method;
+use crate::scene::Method;
 
 /// Everything `result.json` holds.
 #[derive(Debug, Clone, Serialize)]

@@ -202,7 +202,7 @@ mod tests {
     fn result(m: Metrics) -> ExerciseResult {
         let e = exercise();
         ExerciseResult {
-            method: crate::sim_body::Method::Xpbd,
+            method: crate::scene::Method::Xpbd,
             exercise: e.name.clone(),
             exercise_file: "e.ron".into(),
             description: String::new(),

@@ -3,6 +3,7 @@
 //! is told of the scalpel.
 
 pub mod drawn_body;
+pub mod plan_decal;
 pub mod render_command;
 pub mod run_pictures;
 pub mod screenshots;

@@ -15,7 +15,7 @@ use incise_xr::{
     BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View,
 };
 
-use crate::exercise::PlanDecal;
+use super::plan_decal::PlanDecal;
 use crate::sim_body::{Body, DeviceChoice, auto_device};
 
 /// An image size `WIDTHxHEIGHT` given on the command line.

@@ -13,8 +13,8 @@ use anyhow::{Context, Result};
 use incise_sim::xpbd::FrameStats;
 use serde::Serialize;
 
+use crate::scene::Method;
 use crate::scene::Scene;
-use crate::sim_body::method::Method;
 
 /// One frame's line in the report.
 #[derive(Debug, Clone, Serialize)]

@@ -55,7 +55,11 @@ impl<'o> FrameLoop<'o> {
         };
         let shots = match opts.screenshot_every {
             0 => None,
-            _ => Some(body.screenshots(opts.screenshot_size, opts.screenshot_decal.as_ref())?),
+            _ => Some(RunPictures::for_body(
+                body.as_ref(),
+                opts.screenshot_size,
+                opts.screenshot_decal.as_ref(),
+            )?),
         };
         Ok(FrameLoop {
             opts,
@@ -191,7 +195,7 @@ impl<'o> FrameLoop<'o> {
             return Ok(());
         };
         let path = self.opts.out.join(format!("frame_{frame:05}.png"));
-        self.body.screenshot(shots, &path)
+        shots.save(self.body.as_ref(), &path)
     }
 
     /// After the last frame: the progress bar ended, the collection and the stroke written.

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use crate::exercise::PlanDecal;
+use crate::pictures::plan_decal::PlanDecal;
 use crate::pictures::screenshots::ImageSize;
 use crate::report::Report;
 use crate::sim_body::DeviceChoice;

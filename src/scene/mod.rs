@@ -7,6 +7,7 @@ pub mod hand_tool;
 mod load;
 mod localisation;
 mod material;
+pub mod method;
 mod model;
 mod tool;
 
@@ -15,6 +16,7 @@ pub use build::{BuiltScene, SceneTool, ToolDriver, build_scene, build_scene_driv
 pub use load::{SceneError, load_materials, load_scene, locate, parse_materials, parse_scene};
 pub use localisation::Localisation;
 pub use material::scene_material;
+pub use method::Method;
 pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
     StrokeSpec,

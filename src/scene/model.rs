@@ -27,8 +27,8 @@ pub enum ModelChoice {
 
 impl ModelChoice {
     /// The simulation method the model runs.
-    pub fn method(&self) -> crate::sim_body::Method {
-        use crate::sim_body::Method;
+    pub fn method(&self) -> super::Method {
+        use super::Method;
         match self {
             ModelChoice::Xpbd => Method::Xpbd,
             ModelChoice::MassSpring(_) => Method::Nakao,

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use incise_sim::MeshBuildReport;
 
-use super::interface::Method;
 use crate::report::{MeshInfo, Report};
+use crate::scene::Method;
 use crate::scene::Scene;
 
 /// The counts an edge method's report head gives.

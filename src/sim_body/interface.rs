@@ -5,17 +5,23 @@
 
 use std::path::Path;
 
-pub use super::method::Method;
 use super::outcome::Outcome;
 use super::rest_cut::RestCut;
-use crate::exercise::PlanDecal;
-use crate::pictures::run_pictures::RunPictures;
-use crate::pictures::screenshots::ImageSize;
-use crate::pictures::view_pictures::ViewPictures;
+use super::xpbd_device::Body;
 use crate::report::{FrameData, Report};
+use crate::scene::Method;
 use glam::Vec3;
 use incise_sim::contact::ToolPose;
-use incise_xr::Overlays;
+
+/// What an XPBD body's pictures draw: its solver on its device, skin and scalpel.
+pub struct SolverParts<'a> {
+    /// The solver on its device.
+    pub body: &'a Body,
+    /// The skin embedded in the tets.
+    pub skin: &'a incise_sim::skin::Skin,
+    /// The scene's or the hand's scalpel, when the body has one.
+    pub tool: Option<&'a incise_scalpel::Tool>,
+}
 
 /// What moves the tool in the frame being stepped.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -191,37 +197,9 @@ pub trait SimBody {
     /// run prints at its end, where the method has one.
     fn finish(&mut self, report: &mut Report) -> anyhow::Result<Option<String>>;
 
-    /// An offscreen renderer of `size` for this body (its tool and `decal`, an exercise's
-    /// plan, drawn on XPBD bodies): by default, pictures of its tet view with the heat map
-    /// of its quantity.
-    fn screenshots(
-        &self,
-        size: ImageSize,
-        decal: Option<&PlanDecal>,
-    ) -> anyhow::Result<RunPictures> {
-        if decal.is_some() {
-            anyhow::bail!(
-                "an exercise's plan is drawn on XPBD bodies only; this body's method is {}",
-                self.method().name()
-            );
-        }
-        let heat_map = Overlays {
-            stress: true,
-            ..Overlays::default()
-        };
-        Ok(RunPictures::Views(Box::new(ViewPictures::new(
-            size, heat_map,
-        )?)))
-    }
-
-    /// Draw the body now with `shots` (from [`SimBody::screenshots`]) into the PNG `path`.
-    fn screenshot(&self, shots: &mut RunPictures, path: &Path) -> anyhow::Result<()> {
-        match shots {
-            RunPictures::Views(v) => v.save(self.tet_view(), self.scalpel_pose(), path),
-            RunPictures::Solver(_) => anyhow::bail!(
-                "XPBD screenshots cannot draw a {} body",
-                self.method().name()
-            ),
-        }
+    /// The XPBD solver's parts that its own pictures draw (the solver on its device, the
+    /// skin, the scalpel); `None` for a body drawn from its [`SimBody::tet_view`].
+    fn solver_parts(&self) -> Option<SolverParts<'_>> {
+        None
     }
 }

@@ -4,7 +4,6 @@
 
 pub mod edge_report;
 pub mod interface;
-pub mod method;
 pub mod nakao;
 pub mod nakao_blade;
 pub mod nakao_haptic;
@@ -22,9 +21,8 @@ pub mod xpbd;
 pub mod xpbd_device;
 
 pub use interface::{
-    Fault, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
+    Fault, OpenOptions, Quantity, SimBody, SolverParts, StepError, Surface, TetView, ToolInput,
 };
-pub use method::Method;
 pub use open::open;
 pub use outcome::Outcome;
 pub use rest_cut::{RestCut, RestCutFace};

@@ -21,7 +21,7 @@ use incise_sim::mass_spring::{
 use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, opening_width};
 use incise_sim::nakao_cut::{BladePose, Cutter};
 
-use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
+use super::interface::{Fault, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
 use super::nakao_blade::{Blade, stroke_hand, tool_point, touches};
 use super::nakao_outcome::model_outcome;
 use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};
@@ -29,6 +29,7 @@ use super::outcome::Outcome;
 use super::rest_cut::{RestCut, cut_faces_at_rest};
 use crate::report::localisation::{LocalisationInfo, LoopSample, LoopSplit};
 use crate::report::{EdgeFrameStats, FrameData, NakaoInfo, Report};
+use crate::scene::Method;
 use crate::scene::{Localisation, MassSpringScene};
 
 /// The heat map of a Nakao body: the spring tension at each node.

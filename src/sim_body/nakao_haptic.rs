@@ -14,10 +14,11 @@ use incise_sim::contact::ToolPose;
 use incise_sim::mass_spring::{HapticConfig, HapticLoop, LocalLoopParams, MassSpringModel};
 use incise_sim::nakao_cut::BladePose;
 
-use super::interface::{Fault, Method, SimBody, StepError, Surface, TetView, ToolInput};
+use super::interface::{Fault, SimBody, StepError, Surface, TetView, ToolInput};
 use super::nakao_blade::{Blade, tool_point};
 use super::outcome::Outcome;
 use crate::report::{EdgeFrameStats, FrameData, HapticInfo, Report};
+use crate::scene::Method;
 use crate::scene::{Localisation, MassSpringScene, StrokeSpec};
 
 /// The model, on this thread before the first frame and after the last, else on the

@@ -11,10 +11,11 @@ use incise_sim::nakao_cut::measure::counts;
 use incise_sim::{MeshBuildReport, TetMesh};
 
 use super::edge_report::{HeadCounts, edge_method_head};
-use super::interface::{Method, OpenOptions, SimBody};
+use super::interface::{OpenOptions, SimBody};
 use super::nakao::NakaoBody;
 use super::nakao_haptic::NakaoHapticBody;
 use crate::report::{MaterialInfo, Report};
+use crate::scene::Method;
 use crate::scene::{MassSpringScene, Scene, raw_mesh, scene_material};
 
 /// Open the mass-spring scene `scene` (model settings `ms`, file `path`) as `opts` asks.

@@ -15,10 +15,11 @@ use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::rheology::{FlatIndenter, PressSchedule, RheologyBody as Model, RheologyState};
 
-use super::interface::{Fault, Method, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
+use super::interface::{Fault, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
 use super::outcome::{Outcome, StateHash};
 use crate::report::{EdgeFrameStats, FrameData, Report};
 use crate::scene::IndenterSpec;
+use crate::scene::Method;
 
 /// The heat map of a rheological body: the mean edge strain magnitude at each node.
 const STRAIN: Quantity = Quantity {

@@ -11,9 +11,10 @@ use incise_sim::rheology::{
 use incise_sim::{MeshBuildReport, TetMesh};
 
 use super::edge_report::{HeadCounts, edge_method_head};
-use super::interface::{Method, OpenOptions};
+use super::interface::OpenOptions;
 use super::rheology::{Press, RheologyBody};
 use crate::report::{RegionMaterialInfo, Report, RheologyInfo};
+use crate::scene::Method;
 use crate::scene::{RegionSelect, RheologyScene, Scene, SceneError, locate, raw_mesh};
 
 /// Open the rheology scene `scene` (model settings `rh`, file `path`).

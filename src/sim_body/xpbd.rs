@@ -13,16 +13,14 @@ use incise_sim::skin::Skin;
 use incise_sim::xpbd::SolverError;
 
 use super::interface::{
-    Fault, Method, OpenOptions, Quantity, SimBody, StepError, Surface, TetView, ToolInput,
+    Fault, OpenOptions, Quantity, SimBody, SolverParts, StepError, Surface, TetView, ToolInput,
 };
 use super::outcome::{Outcome, StateHash};
 use super::rest_cut::RestCut;
 use super::vertex_field::vertex_mean;
 use super::xpbd_device::Body;
-use crate::exercise::PlanDecal;
-use crate::pictures::run_pictures::RunPictures;
-use crate::pictures::screenshots::{ImageSize, Screenshots};
 use crate::report::{FrameData, MaterialInfo, MeshInfo, Report, ToolInfo};
+use crate::scene::Method;
 use crate::scene::{BuiltScene, SceneTool, ToolDriver, build_scene_driven};
 
 /// The heat map of an XPBD body: the tets' von Mises stress at their nodes.
@@ -331,29 +329,12 @@ impl SimBody for XpbdBody {
         Ok(None)
     }
 
-    fn screenshots(&self, size: ImageSize, decal: Option<&PlanDecal>) -> Result<RunPictures> {
-        let shots = Screenshots::new(
-            None,
-            self.body.solver(),
-            &self.skin,
-            size,
-            Default::default(),
-        )?;
-        let shots = match &self.tool {
-            Some(t) => shots.with_tool(&t.tool),
-            None => shots,
-        };
-        Ok(RunPictures::Solver(Box::new(match decal {
-            Some(d) => shots.with_decal(d.clone()),
-            None => shots,
-        })))
-    }
-
-    fn screenshot(&self, shots: &mut RunPictures, path: &Path) -> Result<()> {
-        match shots {
-            RunPictures::Solver(s) => s.save(&self.body, path),
-            RunPictures::Views(v) => v.save(self.tet_view(), self.scalpel_pose(), path),
-        }
+    fn solver_parts(&self) -> Option<SolverParts<'_>> {
+        Some(SolverParts {
+            body: &self.body,
+            skin: &self.skin,
+            tool: self.tool.as_ref().map(|t| &t.tool),
+        })
     }
 }
 

@@ -18,9 +18,8 @@ use serde::Serialize;
 
 use super::xr_body::XrBody;
 use crate::exercise::live::{ATTEMPT_PICTURE, attempt_view_pictures};
-use crate::exercise::{
-    AttemptBody, LiveExercise, LoadedExercise, PlanDecal, PoseRecording, ToolFrame,
-};
+use crate::exercise::{AttemptBody, LiveExercise, LoadedExercise, PoseRecording, ToolFrame};
+use crate::pictures::plan_decal::PlanDecal;
 use crate::pictures::screenshots::Screenshots;
 use crate::sim_body::Body;
 use crate::sim_body::recorded::RecordedBody;

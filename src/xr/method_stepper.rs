@@ -13,8 +13,9 @@ use super::sim_mode::SimMode;
 use super::sim_state::{Advanced, CommandStamp};
 use super::sim_thread::MAX_CATCH_UP;
 use crate::pictures::tet_drawing::TetDrawing;
+use crate::scene::Method;
 use crate::sim_body::recorded::RecordedBody;
-use crate::sim_body::{Method, TetView, ToolInput};
+use crate::sim_body::{TetView, ToolInput};
 
 /// The body of a session: stepped inside the display frame, or on its own thread.
 pub enum Stepper {

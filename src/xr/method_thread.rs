@@ -17,8 +17,9 @@ use incise_sim::contact::ToolPose;
 
 use super::latest::Latest;
 use super::sim_state::CommandStamp;
+use crate::scene::Method;
 use crate::sim_body::recorded::RecordedBody;
-use crate::sim_body::{Method, TetView, ToolInput};
+use crate::sim_body::{TetView, ToolInput};
 
 /// How long the thread sleeps when it has caught up with the display.
 const IDLE: Duration = Duration::from_millis(1);

@@ -35,7 +35,8 @@ use incise_xr::openxr::scalpel_pose::BladeOffset;
 use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{Headset, XrSession};
 
-use crate::sim_body::{DeviceChoice, Method};
+use crate::scene::Method;
+use crate::sim_body::DeviceChoice;
 use exercise::XrExercise;
 use script::{HeadsetScript, Pacing, RightTrack};
 use sim_mode::{SimChoice, SimMode};

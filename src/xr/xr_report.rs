@@ -11,7 +11,7 @@ use serde::Serialize;
 use super::exercise::AttemptSummary;
 use super::frame_log::FrameLog;
 use super::xr_body::CutBox;
-use crate::sim_body::Method;
+use crate::scene::Method;
 
 /// The session summary written as `xr_report.json`.
 #[derive(Debug, Default, Serialize)]

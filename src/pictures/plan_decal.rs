@@ -8,8 +8,6 @@ use incise_sim::TetMesh;
 use incise_sim::mesh::{closest_point_on_triangle, shape_matrix};
 use incise_xr::SurfaceLine;
 
-use super::plan::Plan;
-
 /// Spacing of the drawn points along the plan, m (about; the plan's own samples, every
 /// k-th).
 pub const DECAL_SPACING: f64 = 0.001;
@@ -27,6 +25,15 @@ const NUDGE: f32 = 0.02;
 
 /// Barycentric slack under which a point still counts as inside a tet.
 const INSIDE_EPS: f32 = 1e-5;
+
+/// A point of a planned line on the rest surface, m, and the outward normal there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MarkPoint {
+    /// The point, m.
+    pub point: Vec3,
+    /// The outward surface normal.
+    pub normal: Vec3,
+}
 
 /// One drawn point: its tet and barycentric weights, and what is needed to map its rest
 /// normal with the tet's deformation.
@@ -55,13 +62,14 @@ pub struct PlanDecal {
 }
 
 impl PlanDecal {
-    /// Embed `plan` (on `mesh`'s rest surface) in `mesh`: every k-th sample (about
-    /// [`DECAL_SPACING`] apart, the last always) goes into the tet that contains it moved
-    /// slightly inward along its normal, else into the tet of the nearest boundary face.
-    pub fn new(plan: &Plan, mesh: &TetMesh) -> PlanDecal {
-        let step = ((DECAL_SPACING / plan.spacing().max(1e-12)).round() as usize).max(1);
-        let last = plan.samples.len().saturating_sub(1);
-        let mut picked: Vec<usize> = (0..plan.samples.len()).step_by(step).collect();
+    /// Embed a planned line in `mesh`: `marks` sampled every `spacing` (m) along it on
+    /// the rest surface; every k-th (about [`DECAL_SPACING`] apart, the last always) goes
+    /// into the tet that contains it moved slightly inward along its normal, else into the
+    /// tet of the nearest boundary face.
+    pub fn new(marks: &[MarkPoint], spacing: f64, mesh: &TetMesh) -> PlanDecal {
+        let step = ((DECAL_SPACING / spacing.max(1e-12)).round() as usize).max(1);
+        let last = marks.len().saturating_sub(1);
+        let mut picked: Vec<usize> = (0..marks.len()).step_by(step).collect();
         if picked.last().is_some_and(|&i| i != last) {
             picked.push(last);
         }
@@ -70,8 +78,10 @@ impl PlanDecal {
         let anchors = picked
             .iter()
             .map(|&i| {
-                let s = &plan.samples[i];
-                let (p, n) = (s.point.as_vec3(), s.normal.as_vec3());
+                let MarkPoint {
+                    point: p,
+                    normal: n,
+                } = marks[i];
                 let (tet, inside) = match containing_tet(mesh, p - n * nudge) {
                     Some(t) => (t, true),
                     None => (nearest_boundary_tet(mesh, p), false),
@@ -207,7 +217,7 @@ fn nearest_boundary_tet(mesh: &TetMesh, p: Vec3) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exercise::plan::RestSurface;
+    use crate::exercise::{Plan, RestSurface};
     use incise_sim::generate;
 
     /// A 4 × 2 × 1 cm slab of 2.5 mm cells, and a plan along its top: a bent line so
@@ -232,7 +242,7 @@ mod tests {
     #[test]
     fn at_rest_the_line_is_the_plan_every_millimetre() {
         let (mesh, plan) = slab_and_plan();
-        let decal = PlanDecal::new(&plan, &mesh);
+        let decal = plan.decal(&mesh);
         assert_eq!(decal.outside, 0);
         let line = decal.line(&mesh.rest_positions);
         assert_eq!(line.points.len(), decal.len());
@@ -260,7 +270,7 @@ mod tests {
     #[test]
     fn an_affine_deformation_moves_points_and_normals_exactly() {
         let (mesh, plan) = slab_and_plan();
-        let decal = PlanDecal::new(&plan, &mesh);
+        let decal = plan.decal(&mesh);
         let rest = decal.line(&mesh.rest_positions);
         // Stretch, shear and a rotation, then a shift: x ↦ A x + b.
         let a = Mat3::from_rotation_z(0.4)
@@ -322,7 +332,7 @@ mod tests {
     #[test]
     fn short_or_broken_positions_are_gaps_without_panicking() {
         let (mesh, plan) = slab_and_plan();
-        let decal = PlanDecal::new(&plan, &mesh);
+        let decal = plan.decal(&mesh);
         let short = decal.line(&[]);
         assert_eq!(short.points.len(), decal.len());
         assert!((0..decal.len()).all(|i| gap(&short, i)));
@@ -336,7 +346,7 @@ mod tests {
     #[test]
     fn tets_cut_away_take_their_part_of_the_line() {
         let (mesh, plan) = slab_and_plan();
-        let decal = PlanDecal::new(&plan, &mesh);
+        let decal = plan.decal(&mesh);
         // Cut away the tets under the middle third of the line.
         let n = decal.len();
         let mut live = vec![true; mesh.tet_count()];
