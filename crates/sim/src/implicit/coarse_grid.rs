@@ -6,6 +6,7 @@
 use std::collections::HashMap;
 
 use glam::{UVec3, Vec3};
+use rayon::prelude::*;
 
 /// The eight corner offsets of a cube, in trilinear order.
 const CORNERS: [UVec3; 8] = [
@@ -31,6 +32,11 @@ pub struct CoarseGrid {
     pub weights: Vec<NodeWeights>,
     /// Coarse nodes kept.
     pub count: usize,
+    /// Per coarse node, the range of [`CoarseGrid::transpose`] holding its fine nodes.
+    transpose_offsets: Vec<u32>,
+    /// The fine nodes each coarse node interpolates to, with their weights (`weights`
+    /// transposed, so the restriction is a gather, in parallel and in a fixed order).
+    transpose: Vec<(u32, f32)>,
 }
 
 impl CoarseGrid {
@@ -62,35 +68,85 @@ impl CoarseGrid {
             }
         }
         let count = prune(&mut weights, &support);
+        let (transpose_offsets, transpose) = transposed(&weights, count);
         CoarseGrid {
             cell,
             weights,
             count,
+            transpose_offsets,
+            transpose,
         }
     }
 
-    /// `Pᵀ r`: fine node vectors summed onto the coarse nodes (f64, 3 per node).
-    pub fn restrict(&self, r: &[Vec3], out: &mut [f64]) {
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for (w, r) in self.weights.iter().zip(r) {
-            for &(id, wk) in w {
-                let o = 3 * id as usize;
-                out[o] += (wk * r.x) as f64;
-                out[o + 1] += (wk * r.y) as f64;
-                out[o + 2] += (wk * r.z) as f64;
+    /// `Pᵀ r`: fine node vectors summed onto the coarse nodes (f64, 3 per node), each
+    /// coarse node's sum in fine-node order (the same on any thread count).
+    pub fn restrict(&self, r: &[Vec3], out: &mut [f64], parallel: bool) {
+        let node = |(c, o): (usize, &mut [f64])| {
+            let range = self.transpose_offsets[c] as usize..self.transpose_offsets[c + 1] as usize;
+            let mut sum = [0.0f64; 3];
+            for &(i, wk) in &self.transpose[range] {
+                let r = r[i as usize];
+                sum[0] += (wk * r.x) as f64;
+                sum[1] += (wk * r.y) as f64;
+                sum[2] += (wk * r.z) as f64;
             }
+            o.copy_from_slice(&sum);
+        };
+        if parallel {
+            out.par_chunks_mut(3)
+                .enumerate()
+                .with_min_len(8)
+                .for_each(node);
+        } else {
+            out.chunks_mut(3).enumerate().for_each(node);
         }
     }
 
     /// `z += P c`: coarse values interpolated onto the fine nodes.
-    pub fn prolong_add(&self, c: &[f64], z: &mut [Vec3]) {
-        for (w, z) in self.weights.iter().zip(z) {
+    pub fn prolong_add(&self, c: &[f64], z: &mut [Vec3], parallel: bool) {
+        let node = |(w, z): (&NodeWeights, &mut Vec3)| {
             for &(id, wk) in w {
                 let o = 3 * id as usize;
                 *z += wk * Vec3::new(c[o] as f32, c[o + 1] as f32, c[o + 2] as f32);
             }
+        };
+        if parallel {
+            self.weights
+                .par_iter()
+                .zip(z.par_iter_mut())
+                .with_min_len(PROLONG_CHUNK)
+                .for_each(node);
+        } else {
+            self.weights.iter().zip(z.iter_mut()).for_each(node);
         }
     }
+}
+
+/// Fine nodes per rayon task of the prolongation.
+const PROLONG_CHUNK: usize = 1024;
+
+/// `weights` (fine node → its corners) transposed: per coarse node of `count`, the range
+/// of the list of (fine node, weight) pairs with a nonzero weight, in fine-node order.
+fn transposed(weights: &[NodeWeights], count: usize) -> (Vec<u32>, Vec<(u32, f32)>) {
+    let mut offsets = vec![0u32; count + 1];
+    for w in weights {
+        for &(id, _) in w.iter().filter(|(_, wk)| *wk > 0.0) {
+            offsets[id as usize + 1] += 1;
+        }
+    }
+    for c in 0..count {
+        offsets[c + 1] += offsets[c];
+    }
+    let mut fill = offsets.clone();
+    let mut list = vec![(0u32, 0.0f32); offsets[count] as usize];
+    for (i, w) in weights.iter().enumerate() {
+        for &(id, wk) in w.iter().filter(|(_, wk)| *wk > 0.0) {
+            let at = &mut fill[id as usize];
+            list[*at as usize] = (i as u32, wk);
+            *at += 1;
+        }
+    }
+    (offsets, list)
 }
 
 /// Least total weight a corner must carry to be a coarse node, in fine nodes: a corner
@@ -158,9 +214,16 @@ mod tests {
             .map(|k| (k as f64 * 0.1).cos())
             .collect();
         let mut pr = vec![0.0; 3 * grid.count];
-        grid.restrict(&r, &mut pr);
+        grid.restrict(&r, &mut pr, false);
         let mut z = vec![Vec3::ZERO; pts.len()];
-        grid.prolong_add(&c, &mut z);
+        grid.prolong_add(&c, &mut z, false);
+        // In parallel: the same values.
+        let mut pr2 = vec![1.0; 3 * grid.count];
+        grid.restrict(&r, &mut pr2, true);
+        assert_eq!(pr, pr2);
+        let mut z2 = vec![Vec3::ZERO; pts.len()];
+        grid.prolong_add(&c, &mut z2, true);
+        assert_eq!(z, z2);
         // (Pᵀ r)·c == r·(P c)
         let lhs: f64 = pr.iter().zip(&c).map(|(a, b)| a * b).sum();
         let rhs: f64 = r.iter().zip(&z).map(|(a, b)| a.dot(*b) as f64).sum();

@@ -9,23 +9,25 @@ use glam::{Mat3, Vec3};
 
 use super::coarse_system::RestTet;
 use super::tet_tangent::TetTangent;
-use crate::xpbd::lanes::{LANES, Lane, M3, V3};
+use crate::xpbd::lanes::{LANES, Lane, M3, V3, store_mat, store_vec};
 
 /// Eight tets' rest data: nodes, `Dm⁻¹` and `V b_a` for a = 1, 2, 3 (lanes past `count`
-/// are padding).
+/// are padding). Matrices and vectors are stored entry by entry across the lanes, so
+/// each value is one contiguous load (issue 35 item 2).
 #[derive(Debug, Clone, Copy)]
 pub struct RestLanes {
     nodes: [[u32; 4]; LANES],
     count: usize,
-    dm_inv: [Mat3; LANES],
-    vb: [[Vec3; LANES]; 3],
+    dm_inv: [[f32; LANES]; 9],
+    vb: [[[f32; LANES]; 3]; 3],
 }
 
-/// Eight tets' tangents at the current iterate: `F`, `cof F`, μ, c, s₃.
+/// Eight tets' tangents at the current iterate: `F`, `cof F`, μ, c, s₃ (stored entry by
+/// entry across the lanes).
 #[derive(Debug, Clone, Copy)]
 pub struct TangentLanes {
-    f: [Mat3; LANES],
-    cof: [Mat3; LANES],
+    f: [[f32; LANES]; 9],
+    cof: [[f32; LANES]; 9],
     scalars: [[f32; LANES]; 3],
 }
 
@@ -37,14 +39,14 @@ pub fn rest_lanes(tets: &[RestTet], b: &[[Vec3; 4]]) -> Vec<RestLanes> {
             let mut r = RestLanes {
                 nodes: [[0; 4]; LANES],
                 count: t.len(),
-                dm_inv: [Mat3::ZERO; LANES],
-                vb: [[Vec3::ZERO; LANES]; 3],
+                dm_inv: [[0.0; LANES]; 9],
+                vb: [[[0.0; LANES]; 3]; 3],
             };
             for k in 0..t.len() {
                 r.nodes[k] = t[k].nodes;
-                r.dm_inv[k] = t[k].dm_inv;
+                store_mat(&mut r.dm_inv, k, t[k].dm_inv);
                 for a in 0..3 {
-                    r.vb[a][k] = b[k][a + 1] * t[k].volume;
+                    store_vec(&mut r.vb[a], k, b[k][a + 1] * t[k].volume);
                 }
             }
             r
@@ -55,13 +57,18 @@ pub fn rest_lanes(tets: &[RestTet], b: &[[Vec3; 4]]) -> Vec<RestLanes> {
 /// The tangents `t(0..n)` (n ≤ 8) in lanes; the lanes past `n` are unused.
 pub fn tangent_lanes(n: usize, t: impl Fn(usize) -> TetTangent) -> TangentLanes {
     let mut out = TangentLanes {
-        f: [Mat3::IDENTITY; LANES],
-        cof: [Mat3::IDENTITY; LANES],
+        f: [[0.0; LANES]; 9],
+        cof: [[0.0; LANES]; 9],
         scalars: [[0.0; LANES]; 3],
     };
+    for k in 0..LANES {
+        store_mat(&mut out.f, k, Mat3::IDENTITY);
+        store_mat(&mut out.cof, k, Mat3::IDENTITY);
+    }
     for k in 0..n {
         let (f, cof, mu, c, s3) = t(k).parts();
-        (out.f[k], out.cof[k]) = (f, cof);
+        store_mat(&mut out.f, k, f);
+        store_mat(&mut out.cof, k, cof);
         (out.scalars[0][k], out.scalars[1][k], out.scalars[2][k]) = (mu, c, s3);
     }
     out
@@ -122,8 +129,8 @@ fn product_in<L: Lane>(
         c1: V3::gather(&d[2]) - d0,
         c2: V3::gather(&d[3]) - d0,
     };
-    let df = ds.mul_mat(&M3::gather(&rest.dm_inv));
-    let (f, cof) = (M3::<L>::gather(&tan.f), M3::<L>::gather(&tan.cof));
+    let df = ds.mul_mat(&M3::load(&rest.dm_inv));
+    let (f, cof) = (M3::<L>::load(&tan.f), M3::<L>::load(&tan.cof));
     let (mu, c, s3) = (
         L::new(tan.scalars[0]),
         L::new(tan.scalars[1]),
@@ -136,13 +143,17 @@ fn product_in<L: Lane>(
         c2: df.c0.cross(f.c1) + f.c0.cross(df.c1),
     };
     let dp = df * mu + cof * (c * dj) + dcof * s3;
-    let f1 = dp.mul_vec(V3::gather(&rest.vb[0]));
-    let f2 = dp.mul_vec(V3::gather(&rest.vb[1]));
-    let f3 = dp.mul_vec(V3::gather(&rest.vb[2]));
+    let f1 = dp.mul_vec(V3::load(&rest.vb[0]));
+    let f2 = dp.mul_vec(V3::load(&rest.vb[1]));
+    let f3 = dp.mul_vec(V3::load(&rest.vb[2]));
     let f0 = -(f1 + f2 + f3);
+    // Each value stored once, then read lane by lane (`lane(k)` per lane would store
+    // the registers again for every k).
+    let arrays = |v: V3<L>| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
+    let f = [arrays(f0), arrays(f1), arrays(f2), arrays(f3)];
     for k in 0..rest.count {
         out[k] = if live[k] {
-            [f0.lane(k), f1.lane(k), f2.lane(k), f3.lane(k)]
+            std::array::from_fn(|a| Vec3::new(f[a][0][k], f[a][1][k], f[a][2][k]))
         } else {
             [Vec3::ZERO; 4]
         };

@@ -214,7 +214,7 @@ impl NewtonWorkspace {
                 self.params.cg_iterations,
                 self.params.cg_tolerance,
                 |p, out| hessian.apply(p, out, live, free, parallel),
-                |r, z| pre.apply(r, z, free),
+                |r, z| pre.apply(r, z, free, parallel),
             );
             report.iterations += 1;
             report.cg_products += cg.iterations;
@@ -425,13 +425,13 @@ impl Hessian {
 
 impl TwoLevel {
     /// `z = D⁻¹ r + P A_c⁻¹ Pᵀ r` (additive two-level; zero at fixed nodes).
-    fn apply(&mut self, r: &[Vec3], z: &mut [Vec3], free: &[bool]) {
+    fn apply(&mut self, r: &[Vec3], z: &mut [Vec3], free: &[bool], parallel: bool) {
         for i in 0..r.len() {
             z[i] = self.diag_inv[i] * r[i];
         }
-        self.grid.restrict(r, &mut self.rhs);
+        self.grid.restrict(r, &mut self.rhs, parallel);
         self.coarse.solve(&mut self.rhs);
-        self.grid.prolong_add(&self.rhs, z);
+        self.grid.prolong_add(&self.rhs, z, parallel);
         for (z, f) in z.iter_mut().zip(free) {
             if !f {
                 *z = Vec3::ZERO;

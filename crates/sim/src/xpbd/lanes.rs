@@ -26,6 +26,17 @@ impl<L: Lane> V3<L> {
         z: L::ZERO,
     };
 
+    /// The vector stored component by component (`soa[c][k]`: component c of lane k):
+    /// three contiguous loads.
+    #[inline(always)]
+    pub fn load(soa: &[[f32; LANES]; 3]) -> V3<L> {
+        V3 {
+            x: L::new(soa[0]),
+            y: L::new(soa[1]),
+            z: L::new(soa[2]),
+        }
+    }
+
     /// Lane `k` of `v` is `v[k]`.
     #[inline(always)]
     pub fn gather(v: &[glam::Vec3; LANES]) -> V3<L> {
@@ -137,6 +148,22 @@ impl<L: Lane> M3<L> {
             c0: V3 { x: s, y: z, z },
             c1: V3 { x: z, y: s, z },
             c2: V3 { x: z, y: z, z: s },
+        }
+    }
+
+    /// The matrix stored entry by entry, column-major (`soa[3c + r][k]`: row r of column
+    /// c in lane k, as [`store_mat`] writes it): nine contiguous loads.
+    #[inline(always)]
+    pub fn load(soa: &[[f32; LANES]; 9]) -> M3<L> {
+        let col = |c: usize| V3 {
+            x: L::new(soa[3 * c]),
+            y: L::new(soa[3 * c + 1]),
+            z: L::new(soa[3 * c + 2]),
+        };
+        M3 {
+            c0: col(0),
+            c1: col(1),
+            c2: col(2),
         }
     }
 
@@ -254,6 +281,18 @@ impl<L: Lane> Mul<L> for M3<L> {
             c2: self.c2 * s,
         }
     }
+}
+
+/// Put `m` in lane `k` of `soa`, column-major (what [`M3::load`] reads).
+pub fn store_mat(soa: &mut [[f32; LANES]; 9], k: usize, m: glam::Mat3) {
+    for (e, v) in m.to_cols_array().into_iter().enumerate() {
+        soa[e][k] = v;
+    }
+}
+
+/// Put `v` in lane `k` of `soa` (what [`V3::load`] reads).
+pub fn store_vec(soa: &mut [[f32; LANES]; 3], k: usize, v: glam::Vec3) {
+    (soa[0][k], soa[1][k], soa[2][k]) = (v.x, v.y, v.z);
 }
 
 #[cfg(test)]
