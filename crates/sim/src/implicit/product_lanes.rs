@@ -147,10 +147,13 @@ fn product_in<L: Lane>(
     let f2 = dp.mul_vec(V3::load(&rest.vb[1]));
     let f3 = dp.mul_vec(V3::load(&rest.vb[2]));
     let f0 = -(f1 + f2 + f3);
-    // Each value stored once, then read lane by lane (`lane(k)` per lane would store
-    // the registers again for every k).
-    let arrays = |v: V3<L>| [v.x.to_array(), v.y.to_array(), v.z.to_array()];
-    let f = [arrays(f0), arrays(f1), arrays(f2), arrays(f3)];
+    // Each value stored once, then read lane by lane.
+    let f = [
+        f0.to_arrays(),
+        f1.to_arrays(),
+        f2.to_arrays(),
+        f3.to_arrays(),
+    ];
     for k in 0..rest.count {
         out[k] = if live[k] {
             std::array::from_fn(|a| Vec3::new(f[a][0][k], f[a][1][k], f[a][2][k]))

@@ -52,10 +52,17 @@ unsafe fn project_block<L: Lane>(
         live: L::new(live),
     };
     let dl_h = project_rest_free_lanes(&mut lanes).to_array();
+    // Each position stored once, then read lane by lane.
+    let u = [
+        lanes.u[0].to_arrays(),
+        lanes.u[1].to_arrays(),
+        lanes.u[2].to_arrays(),
+        lanes.u[3].to_arrays(),
+    ];
     for (k, s) in slots.iter().enumerate().filter(|(_, s)| s.live) {
-        for j in 0..4 {
+        for (node, u) in s.nodes.iter().zip(&u) {
             // SAFETY: the caller's contract.
-            unsafe { nodes.set(s.nodes[j], lanes.u[j].lane(k)) };
+            unsafe { nodes.set(*node, Vec3::new(u[0][k], u[1][k], u[2][k])) };
         }
         lambdas[k] = dl_h[k];
     }

@@ -47,14 +47,21 @@ impl<L: Lane> V3<L> {
         }
     }
 
-    /// The vector of lane `k`.
-    #[inline(always)]
+    /// The vector of lane `k` (tests: a pass reads all lanes from [`V3::to_arrays`]).
+    #[cfg(test)]
     pub fn lane(&self, k: usize) -> glam::Vec3 {
         glam::Vec3::new(
             self.x.to_array()[k],
             self.y.to_array()[k],
             self.z.to_array()[k],
         )
+    }
+
+    /// The components as arrays (`[x, y, z][k]`: lane k), stored once so that reading
+    /// every lane does not store the registers again for each.
+    #[inline(always)]
+    pub fn to_arrays(self) -> [[f32; LANES]; 3] {
+        [self.x.to_array(), self.y.to_array(), self.z.to_array()]
     }
 
     /// Dot product per lane.
