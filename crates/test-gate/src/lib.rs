@@ -118,7 +118,7 @@ pub enum GateError {
         /// Its value.
         value: String,
         /// The values it takes, in words.
-        accepted: &'static str,
+        accepted: String,
     },
     /// `INCISE_BLESS` is `value` while `CI` is set.
     BlessUnderCi {
@@ -146,9 +146,14 @@ impl fmt::Display for GateError {
 
 impl std::error::Error for GateError {}
 
-/// The accepted values of a need's variable, in words.
-const GATE_VALUES: &str = "use 1 (a missing need fails the test), 0 (it skips) or leave it \
-                           unset (it skips, but fails when CI is set)";
+/// The accepted values of `need`'s variable, in words.
+fn gate_values(need: Need) -> String {
+    format!(
+        "use 1 (missing {} fails the test), 0 (it skips) or leave it unset (it skips, but \
+         fails when CI is set)",
+        need.what()
+    )
+}
 /// The accepted values of `INCISE_BLESS`, in words.
 const BLESS_VALUES: &str = "use pictures, scores or all, or leave it unset (compare, rewrite \
                             nothing)";
@@ -167,7 +172,7 @@ pub fn decide(need: Need, value: Option<&str>, ci: Option<&str>) -> Result<Gate,
         Some(v) => Err(GateError::Unknown {
             var: need.var(),
             value: v.to_string(),
-            accepted: GATE_VALUES,
+            accepted: gate_values(need),
         }),
     }
 }
@@ -195,7 +200,7 @@ fn parse_blessed(v: &str) -> Result<Blessed, GateError> {
         _ => Err(GateError::Unknown {
             var: BLESS,
             value: v.to_string(),
-            accepted: BLESS_VALUES,
+            accepted: BLESS_VALUES.to_string(),
         }),
     }
 }
@@ -207,19 +212,31 @@ fn env(var: &str) -> Option<String> {
 }
 
 /// The gate for `need` here; panics when its variable's value is not understood.
+#[track_caller]
 pub fn gate(need: Need) -> Gate {
-    decide(need, env(need.var()).as_deref(), env(CI).as_deref()).unwrap_or_else(|e| panic!("{e}"))
+    match decide(need, env(need.var()).as_deref(), env(CI).as_deref()) {
+        Ok(g) => g,
+        Err(e) => panic!("{e}"),
+    }
 }
 
 /// Whether a missing `need` fails the test here; panics on a value not understood.
+#[track_caller]
 pub fn required(need: Need) -> bool {
     gate(need) != Gate::Skip
 }
 
 /// `need` is missing because `why`: print that the test skips and return, or panic when
 /// the need is required here.
+#[track_caller]
 pub fn skip_or_fail(need: Need, why: impl fmt::Display) {
-    match gate(need) {
+    act(need, gate(need), why)
+}
+
+/// Skip (saying why) or fail by `gate`: `need` is missing because `why`.
+#[track_caller]
+fn act(need: Need, gate: Gate, why: impl fmt::Display) {
+    match gate {
         Gate::Skip => eprintln!("skipping: {why} (set {}=1 to fail instead)", need.var()),
         Gate::RequiredByVar => panic!("{}=1 but {why}", need.var()),
         Gate::RequiredByCi => panic!(
@@ -230,17 +247,28 @@ pub fn skip_or_fail(need: Need, why: impl fmt::Display) {
     }
 }
 
-/// The thing `found` holds, or `None` after [`skip_or_fail`] with its error.
+/// The thing `found` holds, or `None` after [`skip_or_fail`] with its error. The need's
+/// variable is read either way, so a value not understood fails even where the need is met.
+#[track_caller]
 pub fn or_skip<T, E: fmt::Display>(need: Need, found: Result<T, E>) -> Option<T> {
-    found.map_err(|e| skip_or_fail(need, e)).ok()
+    let gate = gate(need);
+    match found {
+        Ok(t) => Some(t),
+        Err(e) => {
+            act(need, gate, e);
+            None
+        }
+    }
 }
 
 /// Whether this run rewrites `kind` instead of comparing with it; panics on an
 /// `INCISE_BLESS` not understood or set under CI.
+#[track_caller]
 pub fn bless(kind: Bless) -> bool {
-    blessing(env(BLESS).as_deref(), env(CI).as_deref())
-        .unwrap_or_else(|e| panic!("{e}"))
-        .covers(kind)
+    match blessing(env(BLESS).as_deref(), env(CI).as_deref()) {
+        Ok(b) => b.covers(kind),
+        Err(e) => panic!("{e}"),
+    }
 }
 
 #[cfg(test)]

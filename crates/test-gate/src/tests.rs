@@ -59,6 +59,7 @@ fn any_other_value_is_an_error_naming_the_variable_and_the_values() {
                     msg.contains("use 1") && msg.contains("0 (it skips)"),
                     "{msg}"
                 );
+                assert!(msg.contains(need.what()), "{msg}");
             }
         }
     }
@@ -116,6 +117,7 @@ fn an_unknown_bless_value_is_an_error_listing_the_values() {
     }
 }
 
+/// (Reads the need's variable, which must be understood where this test runs.)
 #[test]
 fn or_skip_passes_what_was_found() {
     assert_eq!(or_skip(Need::Gpu, Ok::<_, String>(7)), Some(7));
