@@ -236,6 +236,9 @@ pub fn skip_or_fail(need: Need, why: impl fmt::Display) {
 /// Skip (saying why) or fail by `gate`: `need` is missing because `why`.
 #[track_caller]
 fn act(need: Need, gate: Gate, why: impl fmt::Display) {
+    // A child's stderr ends in a newline; the advice goes on the same line.
+    let why = why.to_string();
+    let why = why.trim_end();
     match gate {
         Gate::Skip => eprintln!("skipping: {why} (set {}=1 to fail instead)", need.var()),
         Gate::RequiredByVar => panic!("{}=1 but {why}", need.var()),
