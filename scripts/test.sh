@@ -1,16 +1,37 @@
 #!/usr/bin/env bash
 # The whole test suite: unit, validation and end-to-end tests of every crate, in release
 # mode (the physics validation steps tens of thousands of substeps). GPU tests run on any
-# wgpu adapter (lavapipe without a GPU); with INCISE_REQUIRE_GPU=1 (CI) a missing adapter
-# fails them instead of skipping. The XR tests run against Monado, built once by
-# scripts/monado.sh; with INCISE_REQUIRE_XR=1 or CI set (CI) a Monado that cannot be built
-# fails the run, elsewhere those tests skip.
+# wgpu adapter (lavapipe without a GPU), the XR tests against Monado (built once by
+# scripts/monado.sh), the report test in chromium. Whether a missing one fails or skips
+# is one rule (crates/test-gate): INCISE_REQUIRE_GPU, INCISE_REQUIRE_XR and
+# INCISE_REQUIRE_BROWSER take 1 (fail), 0 (skip) or unset (skip, but fail when CI is set);
+# any other value is an error.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+# required VAR: whether a missing need fails (exit 0) or skips (exit 1), by crates/test-gate's
+# rule; an unknown value stops the run.
+required() {
+    local var="$1" value="${!1:-}"
+    case "$value" in
+        1) return 0 ;;
+        0) return 1 ;;
+        "") [ -n "${CI:-}" ] ;;
+        *)
+            echo "$var=$value is not understood: use 1 (fail), 0 (skip) or leave it unset (skip, but fail when CI is set)" >&2
+            exit 2
+            ;;
+    esac
+}
+# Every gate's value is checked before anything is built.
+for var in INCISE_REQUIRE_GPU INCISE_REQUIRE_XR INCISE_REQUIRE_BROWSER; do
+    required "$var" || true
+done
+
 INCISE_TEST_DEPS=1 source scripts/ensure-deps.sh
 if manifest="$(bash scripts/monado.sh)"; then
     export INCISE_MONADO_MANIFEST="$manifest"
-elif [ -n "${CI:-}" ] || [ "${INCISE_REQUIRE_XR:-0}" = 1 ]; then
+elif required INCISE_REQUIRE_XR; then
     echo "scripts/monado.sh failed: the XR tests need Monado here" >&2
     exit 1
 else

@@ -511,11 +511,9 @@ fn device_auto_picks_the_faster_path_and_says_why() {
                 "{why}"
             );
         }
-        Err(_) => {
-            assert!(
-                !common::gpu_required(),
-                "INCISE_REQUIRE_GPU=1 but no adapter"
-            );
+        Err(e) => {
+            let skipped = format!("{e}: only the fallback to the CPU is checked");
+            incise_test_gate::skip_or_fail(incise_test_gate::Need::Gpu, skipped);
             assert_eq!(device, "cpu");
             assert!(why.contains("no GPU adapter"), "{why}");
         }
@@ -547,16 +545,12 @@ fn intestine_pull_tears() {
 }
 
 /// `--device gpu` runs the same scene on the adapter and reports it; the result agrees
-/// with `--device cpu` (same released count). Skipped without an adapter unless
-/// INCISE_REQUIRE_GPU=1.
+/// with `--device cpu` (same released count). Skipped without an adapter unless the GPU
+/// is required (crates/test-gate).
 #[test]
 fn device_gpu_matches_device_cpu() {
-    if incise_sim::gpu::GpuContext::new().is_err() {
-        assert!(
-            !common::gpu_required(),
-            "INCISE_REQUIRE_GPU=1 but no adapter"
-        );
-        eprintln!("skipping: no GPU adapter");
+    let gate = incise_test_gate::Need::Gpu;
+    if incise_test_gate::or_skip(gate, incise_sim::gpu::GpuContext::new()).is_none() {
         return;
     }
     let dir = temp_dir("device");
@@ -594,12 +588,8 @@ fn device_gpu_matches_device_cpu() {
 /// `incise compare` runs the tearing bar on both devices and finds them in agreement.
 #[test]
 fn compare_finds_cpu_and_gpu_in_agreement() {
-    if incise_sim::gpu::GpuContext::new().is_err() {
-        assert!(
-            !common::gpu_required(),
-            "INCISE_REQUIRE_GPU=1 but no adapter"
-        );
-        eprintln!("skipping: no GPU adapter");
+    let gate = incise_test_gate::Need::Gpu;
+    if incise_test_gate::or_skip(gate, incise_sim::gpu::GpuContext::new()).is_none() {
         return;
     }
     let dir = temp_dir("compare");

@@ -430,8 +430,8 @@ fn reference_passes(name: &str) {
 
 /// The score, completion and released tets of a shipped reference stroke stay what
 /// `tests/golden/score_NAME.json` pins (score within 0.5 points, completion within 1 %,
-/// released tets within 2 %); `INCISE_BLESS=1` rewrites the pin after an intended
-/// change of the physics or the scoring (README, "Tests").
+/// released tets within 2 %); `INCISE_BLESS=scores` (or `all`) rewrites the pin after an
+/// intended change of the physics or the scoring (README, "Tests"; refused under CI).
 fn assert_pinned_score(name: &str, r: &Value) {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/score_{name}.json"));
@@ -440,14 +440,16 @@ fn assert_pinned_score(name: &str, r: &Value) {
         "completion": r["metrics"]["completion"],
         "released_tets": r["metrics"]["released_tets"],
     });
-    if std::env::var("INCISE_BLESS").is_ok_and(|v| v == "1") {
+    if incise_test_gate::bless(incise_test_gate::Bless::Scores) {
         std::fs::write(&path, serde_json::to_string_pretty(&now).unwrap() + "\n").unwrap();
         return;
     }
-    let pinned: Value = serde_json::from_str(
-        &std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("{} ({e}): write it with INCISE_BLESS=1", path.display())),
-    )
+    let pinned: Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap_or_else(|e| {
+        panic!(
+            "{} ({e}): write it with INCISE_BLESS=scores",
+            path.display()
+        )
+    }))
     .unwrap();
     let f = |v: &Value, k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k} in {v}"));
     let close = |k: &str, tol: f64| (f(&now, k) - f(&pinned, k)).abs() <= tol;
@@ -455,7 +457,7 @@ fn assert_pinned_score(name: &str, r: &Value) {
         close("score", 0.5)
             && close("completion", 0.01)
             && close("released_tets", 0.02 * f(&pinned, "released_tets")),
-        "{name}: now {now}, pinned {pinned} in {} (INCISE_BLESS=1 rewrites it if the change is meant)",
+        "{name}: now {now}, pinned {pinned} in {} (INCISE_BLESS=scores rewrites it if the change is meant)",
         path.display()
     );
 }

@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{gpu_required, incise, temp_dir, text};
+use common::{incise, temp_dir, text};
 use serde_json::Value;
 
 #[test]
@@ -284,13 +284,13 @@ fn quick_nakao_plate_cuts_the_plate_as_its_geometry_says() {
 }
 
 /// `incise bench render --frames 1 --case plate --device D --json`, or `None` without an
-/// adapter (skipped unless `INCISE_REQUIRE_GPU=1`).
+/// adapter (skipped, saying why, unless the GPU is required: crates/test-gate).
 fn bench_render(device: &str) -> Option<Value> {
     let o = incise(&[
         "bench", "render", "--frames", "1", "--case", "plate", "--device", device, "--json",
     ]);
-    if !o.status.success() && text(&o.stderr).contains("no GPU adapter") && !gpu_required() {
-        eprintln!("skipping: {}", text(&o.stderr));
+    if !o.status.success() && text(&o.stderr).contains("no GPU adapter") {
+        incise_test_gate::skip_or_fail(incise_test_gate::Need::Gpu, text(&o.stderr));
         return None;
     }
     assert!(o.status.success(), "{}", text(&o.stderr));

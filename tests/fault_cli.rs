@@ -5,7 +5,9 @@
 
 mod common;
 
-use common::{gpu_required, incise, temp_dir, text};
+use common::{incise, temp_dir, text};
+use incise_sim::gpu::GpuContext;
+use incise_test_gate::{Need, or_skip};
 
 fn report(dir: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap()
@@ -14,9 +16,7 @@ fn report(dir: &std::path::Path) -> serde_json::Value {
 #[test]
 fn a_lost_gpu_hands_the_run_to_the_cpu() {
     let out = temp_dir("fault-gpu");
-    if incise_sim::gpu::GpuContext::new().is_err() {
-        assert!(!gpu_required(), "no GPU under INCISE_REQUIRE_GPU=1");
-        eprintln!("skipping: no GPU adapter");
+    if or_skip(Need::Gpu, GpuContext::new()).is_none() {
         return;
     }
     let o = incise(&[
@@ -49,8 +49,8 @@ fn a_lost_gpu_hands_the_run_to_the_cpu() {
 
 #[test]
 fn a_nan_stops_the_run_naming_frame_and_tet_and_keeps_the_output() {
-    let gpu = incise_sim::gpu::GpuContext::new().is_ok();
-    assert!(gpu || !gpu_required(), "no GPU under INCISE_REQUIRE_GPU=1");
+    let found = GpuContext::new().map_err(|e| format!("the GPU half: {e}"));
+    let gpu = or_skip(Need::Gpu, found).is_some();
     let devices: &[&str] = if gpu { &["cpu", "gpu"] } else { &["cpu"] };
     for &device in devices {
         let out = temp_dir(&format!("fault-nan-{device}"));

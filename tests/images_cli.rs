@@ -3,12 +3,13 @@
 //! --simulated-headset`) and the exercise attempt's pictures (`incise exercise`), each
 //! checked for the tissue inside the body's projected screen box, the cut surface where
 //! the stroke cut, CPU/GPU agreement and a small golden PNG (`tests/golden/`, rewritten
-//! with `INCISE_BLESS=1 cargo test --release -p incise --test images_cli`). The preview's
+//! with `INCISE_BLESS=pictures cargo test --release -p incise --test images_cli`). The preview's
 //! window is imaged in tests/preview_xvfb.rs, the exercise's report.html in a headless
 //! browser in tests/report_browser.rs.
 //!
-//! Without a GPU adapter the GPU half is skipped (saying why) unless
-//! `INCISE_REQUIRE_GPU=1` (CI).
+//! Without a GPU adapter the GPU half is skipped (saying why) unless the GPU is required
+//! (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset; crates/test-gate), and without
+//! chromium the browser test likewise unless `INCISE_REQUIRE_BROWSER=1` (or `CI`).
 
 mod common;
 
@@ -18,21 +19,16 @@ use common::pixels::{
     ScreenBox, assert_devices_agree, assert_golden, count, is_cut, is_tissue, projected_box,
     scene_view, share,
 };
-use common::{gpu_required, incise, temp_dir, text};
+use common::{incise, temp_dir, text};
 use glam::{Vec2, Vec3};
+use incise_test_gate::{Need, or_skip, skip_or_fail};
 use incise_xr::RgbaImage;
 
-/// Whether the GPU half of a test runs here: an adapter exists, or `INCISE_REQUIRE_GPU=1`
-/// (where a missing one fails the test).
+/// Whether the GPU half of a test runs here: an adapter exists (where the GPU is required,
+/// a missing one fails the test; elsewhere the half is skipped, saying why).
 fn gpu_here() -> bool {
-    match incise_sim::gpu::GpuContext::new() {
-        Ok(_) => true,
-        Err(e) if gpu_required() => panic!("INCISE_REQUIRE_GPU=1 but {e}"),
-        Err(e) => {
-            eprintln!("skipping the GPU half: {e}");
-            false
-        }
-    }
+    let found = incise_sim::gpu::GpuContext::new().map_err(|e| format!("the GPU half: {e}"));
+    or_skip(Need::Gpu, found).is_some()
 }
 
 const PLATE: &str = "config/plate_cut.ron";
@@ -325,7 +321,8 @@ fn exercise_pictures_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
 }
 
 /// The headless browser: Debian's `chromium`, or `None` (the test is skipped, saying
-/// why) unless `INCISE_REQUIRE_BROWSER=1` (CI, where scripts/test.sh installs it).
+/// why) unless the browser is required (`INCISE_REQUIRE_BROWSER=1`, or `CI` set with it
+/// unset; scripts/test.sh installs it).
 fn chromium() -> Option<&'static str> {
     let found = std::process::Command::new("chromium")
         .arg("--version")
@@ -334,11 +331,10 @@ fn chromium() -> Option<&'static str> {
     if found {
         return Some("chromium");
     }
-    assert!(
-        std::env::var("INCISE_REQUIRE_BROWSER").map_or(true, |v| v != "1"),
-        "INCISE_REQUIRE_BROWSER=1 but chromium is not installed (scripts/test.sh installs it)"
+    skip_or_fail(
+        Need::Browser,
+        "chromium is not installed (scripts/test.sh installs it)",
     );
-    eprintln!("skipping: chromium is not installed");
     None
 }
 

@@ -6,8 +6,8 @@
 //! indenter's depth and creeps back.
 //!
 //! The preview tests need `xvfb-run` and a wgpu adapter (lavapipe will do); without them
-//! they print why and pass, unless `INCISE_REQUIRE_GPU=1` (CI). The headset tests need a
-//! wgpu adapter likewise.
+//! they print why and pass, unless the GPU is required (`INCISE_REQUIRE_GPU=1`, or `CI` set
+//! with it unset; crates/test-gate). The headset tests need a wgpu adapter likewise.
 
 mod common;
 
@@ -16,18 +16,15 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use common::{incise, temp_dir, text};
+use incise_test_gate::{Need, skip_or_fail};
 
-fn required() -> bool {
-    std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
-}
-
-/// Whether `o` failed for want of a GPU adapter and the test may be skipped.
+/// Whether `o` failed for want of a GPU adapter and the test may be skipped (a failure
+/// where the GPU is required).
 fn no_adapter(o: &Output) -> bool {
     let err = text(&o.stderr);
     let missing = !o.status.success() && err.contains("no GPU adapter");
     if missing {
-        assert!(!required(), "INCISE_REQUIRE_GPU=1 but: {err}");
-        eprintln!("skipping: {err}");
+        skip_or_fail(Need::Gpu, err);
     }
     missing
 }
@@ -36,8 +33,7 @@ fn no_adapter(o: &Output) -> bool {
 /// test skipped, saying why).
 fn preview(name: &str, scene: &str, frames: u32) -> Option<String> {
     if Command::new("xvfb-run").arg("--help").output().is_err() {
-        assert!(!required(), "INCISE_REQUIRE_GPU=1 but xvfb-run is missing");
-        eprintln!("skipping: xvfb-run is not installed");
+        skip_or_fail(Need::Gpu, "xvfb-run is not installed");
         return None;
     }
     let dir = temp_dir(name);

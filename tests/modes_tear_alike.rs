@@ -6,13 +6,15 @@
 //!
 //! Every mode runs on its default device (no `--device`). Needs `xvfb-run` and a wgpu
 //! adapter (scripts/ensure-deps.sh installs Xvfb and Mesa's lavapipe); without them the
-//! test prints why and passes, unless `INCISE_REQUIRE_GPU=1` (CI).
+//! test prints why and passes, unless the GPU is required (`INCISE_REQUIRE_GPU=1`, or `CI`
+//! set with it unset; crates/test-gate).
 
 mod common;
 
 use std::process::Command;
 
 use common::{incise, temp_dir, text};
+use incise_test_gate::{Need, skip_or_fail};
 use serde_json::Value;
 
 const SCENE: &str = "config/intestine_pull.ron";
@@ -20,10 +22,6 @@ const SCENE: &str = "config/intestine_pull.ron";
 /// Seconds simulated in each mode: past the first release (frame 49 of 60 Hz) and well
 /// into the tear (987 tets by frame 89 in `incise run`).
 const SECONDS: f64 = 1.5;
-
-fn required() -> bool {
-    std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
-}
 
 /// The number before `word` in `line` ("… 987 tets released").
 fn count_before(line: &str, word: &str) -> u64 {
@@ -61,8 +59,7 @@ fn run_released(frames: u64, out: &std::path::Path) -> u64 {
 /// `None` (said why) without xvfb-run or an adapter when they are not required.
 fn preview_released(frames: u64, dir: &std::path::Path) -> Option<(u64, u64)> {
     if Command::new("xvfb-run").arg("--help").output().is_err() {
-        assert!(!required(), "INCISE_REQUIRE_GPU=1 but xvfb-run is missing");
-        eprintln!("skipping: xvfb-run is not installed");
+        skip_or_fail(Need::Gpu, "xvfb-run is not installed");
         return None;
     }
     let o = Command::new("xvfb-run")
@@ -75,8 +72,8 @@ fn preview_released(frames: u64, dir: &std::path::Path) -> Option<(u64, u64)> {
         .output()
         .expect("xvfb-run runs");
     let err = text(&o.stderr);
-    if !o.status.success() && err.contains("no GPU adapter") && !required() {
-        eprintln!("skipping: {err}");
+    if !o.status.success() && err.contains("no GPU adapter") {
+        skip_or_fail(Need::Gpu, err);
         return None;
     }
     assert!(o.status.success(), "preview failed: {err}");

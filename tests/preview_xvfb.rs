@@ -6,8 +6,8 @@
 //! A left-drag in the window (xdotool) cuts the tissue with the mouse scalpel.
 //!
 //! Needs `xvfb-run` and `xdotool` (scripts/ensure-deps.sh installs them) and a wgpu
-//! adapter; without them the window tests print why and pass, unless
-//! `INCISE_REQUIRE_GPU=1` (CI).
+//! adapter; without them the window tests print why and pass, unless the GPU is required
+//! (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset; crates/test-gate).
 
 mod common;
 
@@ -18,15 +18,12 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
+use incise_test_gate::{Need, skip_or_fail};
 use incise_xr::RgbaImage;
 
-fn required() -> bool {
-    std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
-}
-
 /// `incise preview ARGS --device cpu --screenshot F` under Xvfb; the screenshot, or `None`
-/// (the test is skipped, saying why) without xvfb-run or a GPU adapter unless
-/// `INCISE_REQUIRE_GPU=1`.
+/// (the test is skipped, saying why) without xvfb-run or a GPU adapter unless the GPU is
+/// required.
 fn preview_screenshot(name: &str, args: &[&str]) -> Option<RgbaImage> {
     preview_screenshot_on(name, args, "cpu")
 }
@@ -34,11 +31,10 @@ fn preview_screenshot(name: &str, args: &[&str]) -> Option<RgbaImage> {
 /// [`preview_screenshot`] with the solver on `device`.
 fn preview_screenshot_on(name: &str, args: &[&str], device: &str) -> Option<RgbaImage> {
     if Command::new("xvfb-run").arg("--help").output().is_err() {
-        assert!(
-            !required(),
-            "INCISE_REQUIRE_GPU=1 but xvfb-run is missing (apt-get install xvfb)"
+        skip_or_fail(
+            Need::Gpu,
+            "xvfb-run is not installed (apt-get install xvfb)",
         );
-        eprintln!("skipping: xvfb-run is not installed");
         return None;
     }
     let dir = temp_dir(name);
@@ -96,8 +92,8 @@ fn preview_opens_a_window_renders_and_exits_after_n_frames() {
 /// adapter and the GPU is not required; a failure otherwise.
 fn passed_or_skipped(o: std::process::Output) -> Option<std::process::Output> {
     let err = String::from_utf8_lossy(&o.stderr);
-    if !o.status.success() && err.contains("no GPU adapter") && !required() {
-        eprintln!("skipping: {err}");
+    if !o.status.success() && err.contains("no GPU adapter") {
+        skip_or_fail(Need::Gpu, err);
         return None;
     }
     assert!(o.status.success(), "preview failed: {err}");
@@ -129,11 +125,7 @@ fn xdotool_session(script: &str, cwd: &Path, dir: &Path) -> Option<std::process:
             .is_ok_and(|o| o.status.success())
     };
     if !have("xvfb-run") || !have("xdotool") {
-        assert!(
-            !required(),
-            "INCISE_REQUIRE_GPU=1 but xvfb-run or xdotool is missing"
-        );
-        eprintln!("skipping: xvfb-run or xdotool is not installed");
+        skip_or_fail(Need::Gpu, "xvfb-run or xdotool is not installed");
         return None;
     }
     let o = Command::new("xvfb-run")

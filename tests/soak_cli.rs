@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::{gpu_required, incise, temp_dir, text};
+use common::{incise, temp_dir, text};
 
 /// `incise soak SCENE --seconds SECONDS --device DEVICE --out OUT` (and `extra`): its
 /// output and soak.json's text (empty when it wrote none).
@@ -85,8 +85,8 @@ fn soak_on_the_cpu() {
 
 #[test]
 fn soak_on_the_gpu() {
-    if incise_sim::gpu::GpuContext::new().is_err() && !gpu_required() {
-        eprintln!("skipping the GPU soak: no adapter");
+    let found = incise_sim::gpu::GpuContext::new().map_err(|e| format!("the GPU soak: {e}"));
+    if incise_test_gate::or_skip(incise_test_gate::Need::Gpu, found).is_none() {
         return;
     }
     soak("gpu");

@@ -265,16 +265,10 @@ mod tests {
 
     #[test]
     fn fewer_substeps_keep_state_and_tool_and_reset_goes_back_to_rest() {
-        let dev = match RenderDevice::headless() {
-            Ok(d) => d,
-            // Under INCISE_REQUIRE_GPU=1 (CI) a missing adapter fails the test.
-            Err(e) if std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-                panic!("INCISE_REQUIRE_GPU=1 but {e}")
-            }
-            Err(e) => {
-                eprintln!("skipping: {e}");
-                return;
-            }
+        // Where the GPU is required (crates/test-gate) a missing adapter fails the test.
+        let gate = incise_test_gate::Need::Gpu;
+        let Some(dev) = incise_test_gate::or_skip(gate, RenderDevice::headless()) else {
+            return;
         };
         let (mut xr, _) =
             XrBody::load(Path::new("config/plate_cut.ron"), DeviceChoice::Cpu, &dev).unwrap();

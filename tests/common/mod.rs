@@ -57,9 +57,3 @@ pub fn score_stroke(exercise: &str, stroke: &Path, out: &Path, history: &Path) -
     assert!(o.status.success(), "{}", text(&o.stderr));
     o
 }
-
-/// Whether a GPU adapter is required here: `INCISE_REQUIRE_GPU=1` (CI) turns a missing
-/// adapter into a failure; unset or any other value (`0`) lets GPU tests skip.
-pub fn gpu_required() -> bool {
-    std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1")
-}

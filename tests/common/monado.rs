@@ -3,14 +3,16 @@
 //! Khronos loader, the OpenXR core validation layer and the Vulkan validation layer on
 //! (each where installed; both required under CI).
 //!
-//! Under CI (`CI=true`) or `INCISE_REQUIRE_XR=1`, a Monado that cannot be built or run
-//! fails the test; elsewhere the test is skipped with the reason on stderr.
+//! Where the XR runtime is required (`INCISE_REQUIRE_XR=1`, or `CI` set with it unset;
+//! crates/test-gate), a Monado that cannot be built or run fails the test; elsewhere the
+//! test is skipped with the reason on stderr.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
+use incise_test_gate::{Need, required, skip_or_fail};
 use serde_json::Value;
 
 use super::text;
@@ -20,16 +22,6 @@ const XR_VALIDATION: &str =
     "/usr/share/openxr/1/api_layers/explicit.d/XrApiLayer_core_validation.x86_64-linux-gnu.json";
 /// The Vulkan validation layer's manifest (Debian `vulkan-validationlayers`).
 const VK_VALIDATION: &str = "/usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json";
-
-/// Whether a missing Monado must fail the test (CI, or `INCISE_REQUIRE_XR=1`).
-pub fn required() -> bool {
-    let set = |k: &str| {
-        std::env::var(k)
-            .map(|v| !v.is_empty() && v != "0" && v != "false")
-            .unwrap_or(false)
-    };
-    set("CI") || set("INCISE_REQUIRE_XR")
-}
 
 /// Monado's runtime manifest: `INCISE_MONADO_MANIFEST`, else what `scripts/monado.sh`
 /// builds (or finds in its cache).
@@ -69,14 +61,8 @@ fn build() -> Result<PathBuf, String> {
 /// cannot be had and none is required; a panic when it is.
 pub fn monado() -> Option<&'static Path> {
     static MONADO: OnceLock<Result<PathBuf, String>> = OnceLock::new();
-    match MONADO.get_or_init(build) {
-        Ok(p) => Some(p),
-        Err(why) if required() => panic!("Monado is required here (CI / INCISE_REQUIRE_XR): {why}"),
-        Err(why) => {
-            eprintln!("skipping the Monado test: {why} (set INCISE_REQUIRE_XR=1 to fail instead)");
-            None
-        }
-    }
+    let found = MONADO.get_or_init(build).as_ref().map(PathBuf::as_path);
+    found.map_err(|why| skip_or_fail(Need::Xr, why)).ok()
 }
 
 /// The OpenXR headers Monado bundles (its source tree beside the build in the cache).
@@ -97,13 +83,13 @@ pub struct Validation {
     pub vulkan: bool,
 }
 
-/// The validation layers installed here; under CI both must be.
+/// The validation layers installed here; both must be where the XR runtime is required.
 pub fn validation() -> Validation {
     let v = Validation {
         xr: Path::new(XR_VALIDATION).is_file(),
         vulkan: Path::new(VK_VALIDATION).is_file(),
     };
-    if required() {
+    if required(Need::Xr) {
         assert!(
             v.xr && v.vulkan,
             "CI runs the XR tests with both validation layers: {XR_VALIDATION} and {VK_VALIDATION} (scripts/monado.sh installs them)"

@@ -1,7 +1,7 @@
 //! Pixel checks shared by the image tests of every command that draws: the tissue's and
 //! the cut surface's colours, the body's box on screen (its rest bounding box projected
 //! with the camera that drew it), CPU/GPU agreement and small golden PNGs under
-//! `tests/golden/` (rewritten with `INCISE_BLESS=1`).
+//! `tests/golden/` (rewritten with `INCISE_BLESS=pictures`).
 
 use std::path::{Path, PathBuf};
 
@@ -143,11 +143,11 @@ pub fn golden_path(name: &str) -> PathBuf {
 }
 
 /// Compare `img` with its golden image `tests/golden/NAME.png` (at least 98 % of pixels
-/// within 24 levels per channel). `INCISE_BLESS=1` writes `img` as the golden instead,
-/// after the physics or the renderer changed on purpose.
+/// within 24 levels per channel). `INCISE_BLESS=pictures` (or `all`) writes `img` as the
+/// golden instead, after the physics or the renderer changed on purpose (refused under CI).
 pub fn assert_golden(name: &str, img: &RgbaImage) {
     let path = golden_path(name);
-    if std::env::var("INCISE_BLESS").is_ok_and(|v| v == "1") {
+    if incise_test_gate::bless(incise_test_gate::Bless::Pictures) {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
         img.save_png(&path).unwrap();
         eprintln!("blessed {}", path.display());
@@ -155,7 +155,7 @@ pub fn assert_golden(name: &str, img: &RgbaImage) {
     }
     let golden = RgbaImage::load_png(&path).unwrap_or_else(|e| {
         panic!(
-            "no golden image {} ({e}); write it with INCISE_BLESS=1",
+            "no golden image {} ({e}); write it with INCISE_BLESS=pictures",
             path.display()
         )
     });
@@ -170,7 +170,7 @@ pub fn assert_golden(name: &str, img: &RgbaImage) {
         img.save_png(&seen).unwrap();
         panic!(
             "{name}: only {:.2} % of pixels match {} (this picture: {}); if the change is \
-             meant, rewrite the goldens with INCISE_BLESS=1",
+             meant, rewrite the goldens with INCISE_BLESS=pictures",
             agree * 100.0,
             path.display(),
             seen.display()

@@ -2,7 +2,8 @@
 //! frames, positions within 1e-4 of the mesh size, identical released tets.
 //!
 //! Needs a wgpu adapter (lavapipe in CI). Without one the tests print why and pass,
-//! unless `INCISE_REQUIRE_GPU=1`, which CI sets: then a missing adapter fails them.
+//! unless the GPU is required (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset; see
+//! crates/test-gate): then a missing adapter fails them.
 #![cfg(feature = "gpu")]
 
 mod common;

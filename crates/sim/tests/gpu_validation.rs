@@ -1,8 +1,9 @@
 //! Foundation validation tests on the GPU solver (issue 4, test 2) and the 50,000-frame
 //! soak (test 4). Sizes are kept small for the lavapipe software adapter in CI.
 //!
-//! Needs a wgpu adapter; without one the tests print why and pass, unless
-//! `INCISE_REQUIRE_GPU=1` (CI), which turns a missing adapter into a failure.
+//! Needs a wgpu adapter; without one the tests print why and pass, unless the GPU is
+//! required (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset; crates/test-gate), which
+//! turns a missing adapter into a failure.
 #![cfg(feature = "gpu")]
 
 mod common;

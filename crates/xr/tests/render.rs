@@ -3,9 +3,10 @@
 //! image on failure), the cut surface visible where the tissue tore, and the GPU skin
 //! equal to its barycentric combination after a large deformation.
 //!
-//! Without an adapter the tests print why and pass, unless `INCISE_REQUIRE_GPU=1` (CI):
-//! then they fail. `INCISE_UPDATE_GOLDEN=1` rewrites the stored images instead of
-//! comparing (inspect them before committing).
+//! Without an adapter the tests print why and pass, unless the GPU is required
+//! (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset): then they fail.
+//! `INCISE_BLESS=pictures` (or `all`) rewrites the stored images instead of comparing
+//! (inspect them before committing; refused under CI).
 
 mod common;
 
@@ -31,17 +32,17 @@ const SIZE: (u32, u32) = (320, 240);
 // Cauchy von Mises (twice the seed's eq. 3 value, 6 kPa, at small strain).
 const BAR_THRESHOLD: f32 = 12e3;
 
-/// Compare with `tests/golden/NAME.png`; on failure write the image and a diff beside the
-/// test binaries and fail naming them.
+/// Compare with `tests/golden/NAME.png` (`INCISE_BLESS=pictures` writes it instead); on
+/// failure write the image and a diff beside the test binaries and fail naming them.
 fn check_golden(name: &str, img: &RgbaImage) {
     let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
-    if std::env::var("INCISE_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
+    if incise_test_gate::bless(incise_test_gate::Bless::Pictures) {
         img.save_png(&golden).unwrap();
         eprintln!("updated {}", golden.display());
         return;
     }
     let reference = RgbaImage::load_png(&golden).unwrap_or_else(|e| {
-        panic!("{e}: run with INCISE_UPDATE_GOLDEN=1 to create the golden image, then inspect it")
+        panic!("{e}: run with INCISE_BLESS=pictures to create the golden image, then inspect it")
     });
     let c = compare(img, &reference, Tolerance::default()).unwrap();
     if !c.passed {
@@ -53,7 +54,8 @@ fn check_golden(name: &str, img: &RgbaImage) {
         img.save_png(&actual).unwrap();
         c.diff.save_png(&diff).unwrap();
         panic!(
-            "{name} differs from {}: {c}; see {} and {}",
+            "{name} differs from {}: {c}; see {} and {} (if the change is meant, \
+             INCISE_BLESS=pictures rewrites it)",
             golden.display(),
             actual.display(),
             diff.display()

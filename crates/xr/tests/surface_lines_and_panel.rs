@@ -3,8 +3,8 @@
 //! front of it) and a textured panel quad in the world (the result card), offscreen on
 //! any adapter (lavapipe in CI).
 //!
-//! Without an adapter the tests print why and pass, unless `INCISE_REQUIRE_GPU=1` (CI):
-//! then they fail.
+//! Without an adapter the tests print why and pass, unless the GPU is required
+//! (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset): then they fail.
 
 mod common;
 

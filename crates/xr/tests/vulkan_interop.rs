@@ -3,13 +3,15 @@
 //! into a wgpu device through wgpu-hal, a Vulkan image created outside wgpu (as a
 //! swapchain image) is wrapped as a texture, and the renderer draws a body into it.
 //!
-//! Without a Vulkan driver the test prints why and passes, unless `INCISE_REQUIRE_GPU=1`.
+//! Without a Vulkan driver the test prints why and passes, unless the GPU is required
+//! (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset).
 
 use ash::vk;
 use glam::{UVec3, Vec3};
 use incise_sim::generate::block;
 use incise_sim::skin::Skin;
 use incise_sim::{Material, Solver, SolverParams, TetMesh};
+use incise_test_gate::{Need, or_skip};
 use incise_xr::frame::pinned_nodes;
 use incise_xr::openxr::swapchain::{EYE_FORMAT, wrap_image};
 use incise_xr::openxr::vulkan::{DirectVulkan, create_gpu};
@@ -20,16 +22,8 @@ const SIZE: (u32, u32) = (96, 64);
 
 #[test]
 fn a_foreign_vulkan_device_and_image_render_through_wgpu() {
-    let gpu = match create_gpu(&DirectVulkan) {
-        Ok(g) => g,
-        Err(e) => {
-            assert!(
-                std::env::var("INCISE_REQUIRE_GPU").map_or(true, |v| v != "1"),
-                "INCISE_REQUIRE_GPU=1 but {e}"
-            );
-            eprintln!("skipping: {e}");
-            return;
-        }
+    let Some(gpu) = or_skip(Need::Gpu, create_gpu(&DirectVulkan)) else {
+        return;
     };
     assert_ne!(gpu.vk_instance, 0);
     assert_ne!(gpu.vk_device, 0);

@@ -67,20 +67,15 @@ pub fn max_displacement(s: &Solver) -> f32 {
         .fold(0.0, f32::max)
 }
 
-/// A wgpu device for GPU tests, or `None` (with the reason printed) when no adapter exists.
-/// With `INCISE_REQUIRE_GPU=1` (CI) a missing adapter fails the test instead.
+/// A wgpu device for GPU tests, or `None` (with the reason printed) when no adapter exists;
+/// a failure instead where the GPU is required (`incise_test_gate`: `INCISE_REQUIRE_GPU=1`,
+/// or `CI` set with it unset).
 #[cfg(feature = "gpu")]
 pub fn gpu_context() -> Option<incise_sim::gpu::GpuContext> {
-    match incise_sim::gpu::GpuContext::new() {
-        Ok(c) => Some(c),
-        Err(e) if std::env::var("INCISE_REQUIRE_GPU").is_ok_and(|v| v == "1") => {
-            panic!("INCISE_REQUIRE_GPU=1 but {e}")
-        }
-        Err(e) => {
-            eprintln!("skipping GPU test: {e}");
-            None
-        }
-    }
+    incise_test_gate::or_skip(
+        incise_test_gate::Need::Gpu,
+        incise_sim::gpu::GpuContext::new(),
+    )
 }
 
 /// Edge length of the compression test cube, m.
