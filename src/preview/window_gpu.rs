@@ -32,14 +32,11 @@ pub struct WindowGpu {
 impl WindowGpu {
     /// Open a device that can present to `window`.
     pub fn new(window: Arc<Window>) -> Result<Self> {
-        let instance = wgpu::Instance::new(
-            wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(window.clone())),
-        );
         let size = window.inner_size();
-        let surface = instance
-            .create_surface(window)
-            .map_err(|e| anyhow!("cannot draw into the window: {e}"))?;
-        let dev = pollster::block_on(RenderDevice::open(&instance, Some(&surface)))?;
+        let (surface, dev) = match x11_instance(&window).and_then(|i| open_on(&i, &window).ok()) {
+            Some(opened) => opened,
+            None => open_on(&wgpu_instance(&window), &window)?,
+        };
         let caps = surface.get_capabilities(&dev.adapter);
         let format = caps
             .formats
@@ -189,4 +186,44 @@ impl WindowGpu {
         queue.present(frame);
         Ok(Some(image))
     }
+}
+
+/// A surface for `window` on `instance` and a device that can present to it.
+fn open_on(
+    instance: &wgpu::Instance,
+    window: &Arc<Window>,
+) -> Result<(wgpu::Surface<'static>, RenderDevice)> {
+    let surface = instance
+        .create_surface(window.clone())
+        .map_err(|e| anyhow!("cannot draw into the window: {e}"))?;
+    let dev = pollster::block_on(RenderDevice::open(instance, Some(&surface)))?;
+    Ok((surface, dev))
+}
+
+/// On X11 with no Wayland display in the environment (and no `WGPU_BACKEND` choice), a
+/// Vulkan instance without the Wayland surface extension, so Mesa's device-select layer
+/// does not look for a Wayland display and print "error: XDG_RUNTIME_DIR is invalid or
+/// not set" (issue 34 item 3); `None` elsewhere (wgpu's own instance is used).
+fn x11_instance(window: &Arc<Window>) -> Option<wgpu::Instance> {
+    use winit::raw_window_handle::{HasWindowHandle, RawWindowHandle};
+    let set = |v: &str| std::env::var_os(v).is_some_and(|s| !s.is_empty());
+    let x11 = window.window_handle().is_ok_and(|h| {
+        matches!(
+            h.as_raw(),
+            RawWindowHandle::Xlib(_) | RawWindowHandle::Xcb(_)
+        )
+    });
+    let wayland = set("WAYLAND_DISPLAY") || set("WAYLAND_SOCKET");
+    if x11 && !wayland && !set("WGPU_BACKEND") {
+        incise_xr::vulkan_instance::x11_instance()
+    } else {
+        None
+    }
+}
+
+/// wgpu's own instance for `window` (every backend `WGPU_BACKEND` allows).
+fn wgpu_instance(window: &Arc<Window>) -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+        Box::new(window.clone()),
+    ))
 }

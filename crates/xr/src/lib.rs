@@ -16,7 +16,6 @@ pub mod device;
 pub mod error;
 pub mod frame;
 mod gpu_skin;
-mod headless_vulkan;
 pub mod image_io;
 mod node_world;
 pub mod offscreen;
@@ -29,6 +28,7 @@ mod scene_buffers;
 pub mod shaders;
 mod targets;
 pub mod tool_mesh;
+pub mod vulkan_instance;
 
 pub use camera::{Camera, View};
 pub use device::RenderDevice;

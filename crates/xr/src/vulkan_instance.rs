@@ -1,9 +1,10 @@
-//! A Vulkan instance for offscreen work, created without the window-system extensions
-//! (`VK_KHR_surface`, Xlib, XCB, Wayland, display): with them Mesa's device-select layer
-//! connects to the display to rank GPUs and, on a machine without one, prints "error:
-//! XDG_RUNTIME_DIR is invalid or not set" on every run. wgpu-hal enables every WSI
-//! extension the loader offers and has no switch for it, so the instance is made here and
-//! handed to wgpu-hal, which owns it from then on.
+//! Vulkan instances without the window-system extensions a run does not use: none for
+//! offscreen work ([`instance`]), no Wayland for a window on X11 ([`x11_instance`]). With
+//! `VK_KHR_wayland_surface` enabled, Mesa's device-select layer connects to a Wayland
+//! display to rank GPUs and, where there is none (no `XDG_RUNTIME_DIR`: Xvfb, ssh, CI),
+//! prints "error: XDG_RUNTIME_DIR is invalid or not set" on every run. wgpu-hal enables
+//! every WSI extension the loader offers and has no switch for it, so the instance is
+//! made here and handed to wgpu-hal, which owns it from then on.
 
 use std::ffi::{CStr, c_char};
 
@@ -27,10 +28,20 @@ const WINDOW_SYSTEM: [&CStr; 10] = [
 /// A wgpu instance on a window-less Vulkan instance, or `None` where Vulkan (≥ 1.1) is
 /// not there or refuses (the caller then opens wgpu's own instance).
 pub fn instance() -> Option<wgpu::Instance> {
+    instance_without(&WINDOW_SYSTEM)
+}
+
+/// A wgpu instance on a Vulkan instance that can draw into X11 windows but has no
+/// Wayland surface extension, or `None` as for [`instance`].
+pub fn x11_instance() -> Option<wgpu::Instance> {
+    instance_without(&[ash::khr::wayland_surface::NAME])
+}
+
+/// A wgpu instance on a Vulkan instance with every extension wgpu-hal wants but `left_out`.
+fn instance_without(left_out: &[&CStr]) -> Option<wgpu::Instance> {
     // SAFETY: the system Vulkan loader is loaded and the instance created from it with
     // the extensions listed; wgpu-hal is given exactly that list (it checks it before any
-    // surface use, and no surface is made on this instance) and takes ownership of the
-    // instance (no drop callback).
+    // surface use) and takes ownership of the instance (no drop callback).
     unsafe {
         let entry = ash::Entry::load().ok()?;
         let version = entry
@@ -43,7 +54,7 @@ pub fn instance() -> Option<wgpu::Instance> {
         let version = version.min(vk::API_VERSION_1_3);
         let flags = wgpu::InstanceFlags::empty();
         let mut extensions = hal_vk::Instance::desired_extensions(&entry, version, flags).ok()?;
-        extensions.retain(|e| !WINDOW_SYSTEM.contains(e));
+        extensions.retain(|e| !left_out.contains(e));
         let names: Vec<*const c_char> = extensions.iter().map(|e| e.as_ptr()).collect();
         let app = vk::ApplicationInfo::default()
             .application_name(c"incise")
