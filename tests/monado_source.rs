@@ -58,7 +58,10 @@ fn without_the_tarball_or_upstream_the_script_names_both_fixes() {
     ] {
         assert!(msg.contains(needed), "missing {needed:?} in: {msg}");
     }
-    assert!(!dir.join("cache/monado").exists(), "the failed fetch is cleaned up");
+    assert!(
+        !dir.join("cache/monado").exists(),
+        "the failed fetch is cleaned up"
+    );
 }
 
 #[test]

@@ -116,6 +116,10 @@ pub fn build_scene_driven(
             start_time: g.start,
         });
     }
+    // The implicit scheme's workspace is built at load, not in the first frame.
+    solver
+        .prepare()
+        .with_context(|| format!("{}: solver.scheme", scene_path.display()))?;
     let tool = match (&scene.tool, &scene.stroke) {
         (None, None) if driver == ToolDriver::Hand => {
             let tool = super::hand_tool::default_tool()?;

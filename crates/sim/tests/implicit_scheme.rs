@@ -169,3 +169,39 @@ fn rest_stays_exactly_at_rest() {
         assert_eq!(moved, 0.0, "ν = {nu}: moved {moved} m");
     }
 }
+
+/// `prepare` builds the implicit workspace before the first frame (a scene calls it at
+/// load, so the first frame does not stall), and the frames after it match those of a
+/// solver that built it lazily in its first frame; under XPBD it does nothing.
+#[test]
+fn prepare_builds_the_workspace_before_the_first_frame() {
+    let mesh = || common::block_mesh(Vec3::ZERO, Vec3::new(0.03, 0.02, 0.01), UVec3::new(6, 4, 2));
+    let params = SolverParams {
+        scheme: Scheme::Newton(NewtonParams::default()),
+        threads: 1,
+        ..SolverParams::default()
+    };
+    let open = |prepare: bool| {
+        let mut s = Solver::new(mesh(), common::soft(50e3, 0.45), params.clone()).unwrap();
+        s.pin(&[0, 1, 2, 3]);
+        if prepare {
+            s.prepare().unwrap();
+        }
+        s
+    };
+    let (mut early, mut lazy) = (open(true), open(false));
+    assert!(early.newton_report().is_some(), "built by prepare");
+    assert!(lazy.newton_report().is_none(), "not built before a frame");
+    for _ in 0..5 {
+        early.step_frame().unwrap();
+        lazy.step_frame().unwrap();
+    }
+    assert_eq!(early.positions(), lazy.positions());
+    let xpbd_params = SolverParams {
+        substeps: 40,
+        ..SolverParams::default()
+    };
+    let mut xpbd = Solver::new(mesh(), common::soft(50e3, 0.45), xpbd_params).unwrap();
+    xpbd.prepare().unwrap();
+    assert!(xpbd.newton_report().is_none());
+}
