@@ -49,7 +49,7 @@ impl Default for NewtonParams {
             steps: 1,
             iterations: 5,
             cg_iterations: 100,
-            cg_tolerance: 0.01,
+            cg_tolerance: 0.1,
             gradient_tolerance: 0.01,
             coarse_cell: None,
         }
