@@ -68,9 +68,14 @@ fn assert_tissue_and_cut(what: &str, img: &RgbaImage, body: ScreenBox, cut: (Vec
     let r = (img.width as f32 / 32.0).max(6.0);
     let (near, band) = cut_near_segment(img, cut.0, cut.1, r);
     let all = count(img, is_cut);
+    // The cut fills 29–48 % of the band (render 137 of 458 pixels, each xr eye 101 of 343,
+    // the exercise 7191 of 15067, the same on the CPU and the GPU): a sixth fails when
+    // about 45 % of the render's or an eye's cut is gone, 65 % of the exercise's (the
+    // old floor, 15 pixels, let 90 % of the render's go).
     assert!(
-        near >= 15,
-        "{what}: {near} cut-surface pixels of {band} along the incision {cut:?}"
+        near * 6 >= band,
+        "{what}: {near} cut-surface pixels of {band} along the incision {cut:?} (at least \
+         a sixth should be cut)"
     );
     assert!(
         all <= near * 2 + 20,
