@@ -3,9 +3,10 @@
 //! --simulated-headset`) and the exercise attempt's pictures (`incise exercise`), each
 //! checked for the tissue inside the body's projected screen box, the cut surface where
 //! the stroke cut, CPU/GPU agreement and a small golden PNG (`tests/golden/`, rewritten
-//! with `INCISE_BLESS=pictures cargo test --release -p incise --test images_cli`). The preview's
-//! window is imaged in tests/preview_xvfb.rs, the exercise's report.html in a headless
-//! browser in tests/report_browser.rs.
+//! from the CPU's picture with `INCISE_BLESS=pictures cargo test --release -p incise
+//! --test images_cli`) that both devices' pictures match, whole and by their tissue and
+//! cut-surface masks. The preview's window is imaged in tests/preview_xvfb.rs, the
+//! exercise's report.html in a headless browser at the end of this file.
 //!
 //! Without a GPU adapter the GPU half is skipped (saying why) unless the GPU is required
 //! (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset; crates/test-gate), and without
@@ -16,8 +17,8 @@ mod common;
 use std::path::Path;
 
 use common::pixels::{
-    ScreenBox, assert_devices_agree, assert_golden, count, is_cut, is_tissue, projected_box,
-    scene_view, share,
+    ScreenBox, assert_devices_agree, assert_golden, assert_like_golden, count, is_cut, is_tissue,
+    projected_box, scene_view, share,
 };
 use common::{incise, temp_dir, text};
 use glam::{Vec2, Vec3};
@@ -67,9 +68,14 @@ fn assert_tissue_and_cut(what: &str, img: &RgbaImage, body: ScreenBox, cut: (Vec
     let r = (img.width as f32 / 32.0).max(6.0);
     let (near, band) = cut_near_segment(img, cut.0, cut.1, r);
     let all = count(img, is_cut);
+    // The cut fills 29–48 % of the band (render 137 of 458 pixels, each xr eye 101 of 343,
+    // the exercise 7191 of 15067, the same on the CPU and the GPU): a sixth fails when
+    // about 45 % of the render's or an eye's cut is gone, 65 % of the exercise's (the
+    // old floor, 15 pixels, let 90 % of the render's go).
     assert!(
-        near >= 15,
-        "{what}: {near} cut-surface pixels of {band} along the incision {cut:?}"
+        near * 6 >= band,
+        "{what}: {near} cut-surface pixels of {band} along the incision {cut:?} (at least \
+         a sixth should be cut)"
     );
     assert!(
         all <= near * 2 + 20,
@@ -101,7 +107,7 @@ fn render(dir: &Path, scene: &str, frame: u32, (w, h): (u32, u32), device: &str)
 
 /// `incise render` of plate_cut after 1.2 s of its stroke: the slab fills its projected
 /// box, the cut surface shows along the projected incision (and not before the stroke),
-/// the GPU solver's picture matches the CPU's, and the CPU's matches its golden image.
+/// the GPU solver's picture matches the CPU's, and both match the golden image.
 #[test]
 fn render_shows_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
     let dir = temp_dir("images-render");
@@ -127,6 +133,7 @@ fn render_shows_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
     if gpu_here() {
         let gpu = render(&dir, PLATE, 72, (w, h), "gpu");
         assert_tissue_and_cut("render on the GPU", &gpu, body, cut);
+        assert_like_golden("render_plate_cut_cpu", "gpu", &gpu);
         assert_devices_agree("render", &cpu, &gpu);
     }
 }
@@ -158,8 +165,8 @@ const XR_SCRIPT: &str = r#"(
 
 /// `incise xr --simulated-headset` on the CPU and the GPU: each eye shows the slab in
 /// its box (the rest bounds through the tray and that eye's pose and field of view) and
-/// the cut along the incision; the two devices' eyes agree; the CPU's left eye matches
-/// its golden image.
+/// the cut along the incision; the two devices' eyes agree; both left eyes match the
+/// golden image.
 #[test]
 fn simulated_headset_eyes_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
     let dir = temp_dir("images-xr");
@@ -213,6 +220,7 @@ fn simulated_headset_eyes_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
             assert_tissue_and_cut("xr eye on the GPU", img, body, cut);
             assert_devices_agree("xr eye", &cpu[i], img);
         }
+        assert_like_golden("xr_plate_cut_left_eye_cpu", "gpu", &gpu[0]);
     }
 }
 
@@ -273,8 +281,8 @@ fn halved(img: &RgbaImage) -> RgbaImage {
 
 /// The exercise attempt's pictures (`frame_00000.png` before, `frame_NNNNN.png` after
 /// the stroke) on the CPU and the GPU: the slab fills its box in both, the cut shows
-/// along the plan only after the stroke, the devices agree, and the CPU's after-picture
-/// matches its golden image (at half size).
+/// along the plan only after the stroke, the devices agree, and both after-pictures match
+/// the golden image (at half size).
 #[test]
 fn exercise_pictures_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
     let pictures = |out: &Path| {
@@ -314,6 +322,7 @@ fn exercise_pictures_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
     if gpu_here() {
         let gpu = pictures(&exercise_attempt("gpu"));
         check("exercise on the GPU", &gpu);
+        assert_like_golden("exercise_slab_depth_after_cpu", "gpu", &halved(&gpu[1]));
         for (c, g) in cpu.iter().zip(&gpu) {
             assert_devices_agree("exercise picture", c, g);
         }

@@ -1,6 +1,9 @@
 //! Helpers shared by the end-to-end tests: run the `incise` binary, scratch folders, text.
 #![allow(dead_code)]
 
+/// The tissue and cut-surface masks, shared with the renderer's tests.
+#[path = "../../crates/xr/tests/common/masks.rs"]
+pub mod masks;
 pub mod pixels;
 pub mod xr_report;
 

@@ -1,12 +1,20 @@
 //! Pixel checks shared by the image tests of every command that draws: the tissue's and
 //! the cut surface's colours, the body's box on screen (its rest bounding box projected
 //! with the camera that drew it), CPU/GPU agreement and small golden PNGs under
-//! `tests/golden/` (rewritten with `INCISE_BLESS=pictures`).
+//! `tests/golden/` (rewritten with `INCISE_BLESS=pictures`), compared whole and by their
+//! tissue and cut-surface masks (crates/xr/tests/common/masks.rs, shared with the
+//! renderer's tests).
 
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 use incise_xr::{RgbaImage, View};
+
+use super::masks::{GOLDEN_MASKS, mask_failures};
+// The colour tests, where the image tests have always found them (not every test binary
+// that includes this module uses them).
+#[allow(unused_imports)]
+pub use super::masks::{is_cut, is_tissue};
 
 /// A pixel rectangle, `x0..x1` × `y0..y1`, inside an image.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,20 +89,6 @@ pub fn scene_view(scene: &str, w: u32, h: u32) -> (View, Vec3, Vec3) {
     (view, lo, hi)
 }
 
-/// The tissue's skin (pink: red well above green and blue); the stress heat map and the
-/// cut surface are not skin.
-pub fn is_tissue(p: [u8; 4]) -> bool {
-    let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
-    r > 90 && r - g > 25 && r - b > 10
-}
-
-/// The cut surface: the organ's inside, a darker saturated red (the skin has far more
-/// green and blue).
-pub fn is_cut(p: [u8; 4]) -> bool {
-    let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
-    r > 60 && r > 2 * g && r > 2 * b
-}
-
 /// Share of the pixels in `b` for which `pred` holds.
 pub fn share(img: &RgbaImage, b: ScreenBox, pred: impl Fn([u8; 4]) -> bool) -> f64 {
     b.pixels(img).filter(|p| pred(*p)).count() as f64 / b.area().max(1) as f64
@@ -142,38 +136,67 @@ pub fn golden_path(name: &str) -> PathBuf {
         .join(format!("{name}.png"))
 }
 
-/// Compare `img` with its golden image `tests/golden/NAME.png` (at least 98 % of pixels
-/// within 24 levels per channel). `INCISE_BLESS=pictures` (or `all`) writes `img` as the
-/// golden instead, after the physics or the renderer changed on purpose (refused under CI).
+/// Compare `img` with its golden image `tests/golden/NAME.png` ([`assert_like_golden`]).
+/// `INCISE_BLESS=pictures` (or `all`) writes `img` as the golden instead, after the
+/// physics or the renderer changed on purpose (refused under CI).
 pub fn assert_golden(name: &str, img: &RgbaImage) {
-    let path = golden_path(name);
     if incise_test_gate::bless(incise_test_gate::Bless::Pictures) {
+        let path = golden_path(name);
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
         img.save_png(&path).unwrap();
         eprintln!("blessed {}", path.display());
         return;
     }
-    let golden = RgbaImage::load_png(&path).unwrap_or_else(|e| {
+    assert_like_golden(name, "cpu", img);
+}
+
+/// The golden image `tests/golden/NAME.png`; panics saying how to write it.
+fn load_golden(name: &str) -> RgbaImage {
+    let path = golden_path(name);
+    RgbaImage::load_png(&path).unwrap_or_else(|e| {
         panic!(
             "no golden image {} ({e}); write it with INCISE_BLESS=pictures",
             path.display()
         )
-    });
+    })
+}
+
+/// Compare `img`, drawn with the solver on `device`, with the golden image
+/// `tests/golden/NAME.png`, never rewriting it ([`golden_failures`]). On failure the
+/// picture is saved in the temporary folder and every failed check is named.
+pub fn assert_like_golden(name: &str, device: &str, img: &RgbaImage) {
+    let golden = load_golden(name);
     assert_eq!(
         (img.width, img.height),
         (golden.width, golden.height),
         "{name}: size differs from the golden image"
     );
-    let agree = agreeing_share(img, &golden, 24);
-    if agree < 0.98 {
-        let seen = std::env::temp_dir().join(format!("incise-{name}-actual.png"));
+    let failures = golden_failures(name, &golden, img);
+    if !failures.is_empty() {
+        let seen = std::env::temp_dir().join(format!("incise-{name}-{device}-actual.png"));
         img.save_png(&seen).unwrap();
         panic!(
-            "{name}: only {:.2} % of pixels match {} (this picture: {}); if the change is \
-             meant, rewrite the goldens with INCISE_BLESS=pictures",
-            agree * 100.0,
-            path.display(),
+            "{} (golden {}, this picture on the {device}: {}); if the change is meant, \
+             rewrite the goldens with INCISE_BLESS=pictures",
+            failures.join("\n"),
+            golden_path(name).display(),
             seen.display()
         );
     }
+}
+
+/// How `img` fails its golden, one message a check: the whole picture (at least 98 % of
+/// the pixels within 24 levels per channel) and the tissue and the cut surface where the
+/// golden has them ([`GOLDEN_MASKS`]: the whole-picture allowance, 2 %, is more than
+/// each golden's cut surface, so only the masks see a cut missing, recoloured or moved).
+pub fn golden_failures(name: &str, golden: &RgbaImage, img: &RgbaImage) -> Vec<String> {
+    let agree = agreeing_share(img, golden, 24);
+    let whole = (agree < 0.98).then(|| {
+        format!(
+            "{name}: only {:.2} % of pixels match the golden",
+            agree * 100.0
+        )
+    });
+    let masks = mask_failures(name, golden, img, &GOLDEN_MASKS);
+    whole.into_iter().chain(masks).collect()
 }

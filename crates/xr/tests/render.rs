@@ -1,7 +1,8 @@
 //! Offscreen rendering on any adapter (lavapipe in CI), issue 6 tests 1–3: golden images
 //! of the rest intestine, a torn bar and the stress overlay (perceptual tolerance, a diff
-//! image on failure), the cut surface visible where the tissue tore, and the GPU skin
-//! equal to its barycentric combination after a large deformation.
+//! image on failure; the tissue and the cut surface compared as masks, issue 33), the cut
+//! surface visible where the tissue tore, and the GPU skin equal to its barycentric
+//! combination after a large deformation.
 //!
 //! Without an adapter the tests print why and pass, unless the GPU is required
 //! (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset): then they fail.
@@ -11,6 +12,7 @@
 mod common;
 
 use common::device;
+use common::masks::{GOLDEN_MASKS, MaskCheck, mask_failures};
 
 use std::path::PathBuf;
 
@@ -32,9 +34,11 @@ const SIZE: (u32, u32) = (320, 240);
 // Cauchy von Mises (twice the seed's eq. 3 value, 6 kPa, at small strain).
 const BAR_THRESHOLD: f32 = 12e3;
 
-/// Compare with `tests/golden/NAME.png` (`INCISE_BLESS=pictures` writes it instead); on
-/// failure write the image and a diff beside the test binaries and fail naming them.
-fn check_golden(name: &str, img: &RgbaImage) {
+/// Compare with `tests/golden/NAME.png` (`INCISE_BLESS=pictures` writes it instead): the
+/// perceptual difference, and each of `masks` (the tissue, the cut surface) where the
+/// golden has it; on failure write the image and a diff beside the test binaries and
+/// fail naming them and every failed check.
+fn check_golden(name: &str, img: &RgbaImage, masks: &[MaskCheck]) {
     let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("tests/golden/{name}.png"));
     if incise_test_gate::bless(incise_test_gate::Bless::Pictures) {
         img.save_png(&golden).unwrap();
@@ -45,7 +49,12 @@ fn check_golden(name: &str, img: &RgbaImage) {
         panic!("{e}: run with INCISE_BLESS=pictures to create the golden image, then inspect it")
     });
     let c = compare(img, &reference, Tolerance::default()).unwrap();
-    if !c.passed {
+    let whole = (!c.passed).then(|| format!("{name} differs from {}: {c}", golden.display()));
+    let failures: Vec<String> = whole
+        .into_iter()
+        .chain(mask_failures(name, &reference, img, masks))
+        .collect();
+    if !failures.is_empty() {
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
         let (actual, diff) = (
             dir.join(format!("{name}.actual.png")),
@@ -54,9 +63,8 @@ fn check_golden(name: &str, img: &RgbaImage) {
         img.save_png(&actual).unwrap();
         c.diff.save_png(&diff).unwrap();
         panic!(
-            "{name} differs from {}: {c}; see {} and {} (if the change is meant, \
-             INCISE_BLESS=pictures rewrites it)",
-            golden.display(),
+            "{}; see {} and {} (if the change is meant, INCISE_BLESS=pictures rewrites it)",
+            failures.join("\n"),
             actual.display(),
             diff.display()
         );
@@ -161,7 +169,7 @@ fn golden_rest_intestine() {
     let img = r
         .render_image(&state, &RenderSettings::default(), &view)
         .unwrap();
-    check_golden("rest_intestine", &img);
+    check_golden("rest_intestine", &img, &GOLDEN_MASKS);
     // Nothing is cut at rest: no cut-surface pixels anywhere.
     let ids = RenderSettings {
         shading: ShadingMode::MaterialIds,
@@ -200,7 +208,7 @@ fn golden_torn_bar_shows_the_cut_where_it_tore() {
     let img = r
         .render_image(&state, &RenderSettings::default(), &view)
         .unwrap();
-    check_golden("torn_bar", &img);
+    check_golden("torn_bar", &img, &GOLDEN_MASKS);
     // (b) The cut surface appears, and where the released tets are on screen.
     let after = r.render_image(&state, &ids, &view).unwrap();
     let released: Vec<Vec2> = (0..s.mesh().tet_count())
@@ -251,7 +259,8 @@ fn golden_stress_overlay() {
     let img = r
         .render_image(&BodyState::of_solver(&s, &pinned), &settings, &bar_view())
         .unwrap();
-    check_golden("stress_overlay", &img);
+    // The heat map's colours are neither skin nor cut surface: the whole picture only.
+    check_golden("stress_overlay", &img, &[]);
 }
 
 #[test]
@@ -334,4 +343,51 @@ fn both_eyes_of_a_stereo_target_are_drawn() {
     assert!(drawn(&right_img) > 1000, "the right eye is blank");
     assert_ne!(left.pixels, right_img.pixels, "the eyes see the same image");
     assert!(r.read_image(2).is_err(), "there is no third eye");
+}
+
+/// A 60 × 40 picture: a skin-pink 40 × 20 slab, and on it a 24 × 4 slot of `colour`
+/// whose top left corner is at (`x`, `y`), if any.
+fn slab_with_slot(slot: Option<([u8; 4], u32, u32)>) -> RgbaImage {
+    let mut img = RgbaImage::filled(60, 40, [40, 44, 52, 255]);
+    let mut fill = |(x0, y0): (u32, u32), (w, h): (u32, u32), c: [u8; 4]| {
+        for (x, y) in (x0..x0 + w).flat_map(|x| (y0..y0 + h).map(move |y| (x, y))) {
+            img.set(x, y, c);
+        }
+    };
+    fill((10, 10), (40, 20), [200, 140, 130, 255]);
+    if let Some((colour, x, y)) = slot {
+        fill((x, y), (24, 4), colour);
+    }
+    img
+}
+
+/// The golden masks (no GPU needed): a slot drawn as in the golden, or a pixel off, passes;
+/// one missing, drawn in the skin's colour or moved across or along itself fails on the
+/// cut surface.
+#[test]
+fn golden_masks_fail_a_cut_missing_recoloured_or_moved() {
+    let (skin, cut) = ([200, 140, 130, 255], [80, 15, 15, 255]);
+    let golden = slab_with_slot(Some((cut, 18, 16)));
+    let fails = |img: RgbaImage| mask_failures("slab", &golden, &img, &GOLDEN_MASKS);
+    assert_eq!(
+        fails(slab_with_slot(Some((cut, 18, 16)))),
+        Vec::<String>::new()
+    );
+    assert_eq!(
+        fails(slab_with_slot(Some((cut, 19, 17)))),
+        Vec::<String>::new()
+    );
+    let broken = [
+        ("missing", None),
+        ("in the skin's colour", Some((skin, 18, 16))),
+        ("3 px across", Some((cut, 18, 19))),
+        ("4 px along", Some((cut, 22, 16))),
+    ];
+    for (what, slot) in broken {
+        let f = fails(slab_with_slot(slot));
+        assert!(
+            f.iter().any(|m| m.contains("the cut surface")),
+            "a cut {what} passes: {f:?}"
+        );
+    }
 }

@@ -2,6 +2,8 @@
 
 use incise_xr::RenderDevice;
 
+pub mod masks;
+
 /// A headless render device (lavapipe without a GPU); `None` skips the test (saying why),
 /// except where the GPU is required (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset),
 /// where a missing adapter fails it.
