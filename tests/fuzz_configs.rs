@@ -1,6 +1,9 @@
 //! Issue 11: the RON parsers of scenes, tools, strokes, exercises and headset scripts
 //! survive mutation fuzzing seeded with the shipped files (≥ 100k inputs per format by default, `INCISE_FUZZ_INPUTS` to
-//! change): no panic, no input slower than 1 s, never more than 10× the input allocated.
+//! change): no panic, no input slower than 1 s, never more than 10× the input allocated;
+//! each format's mutants are both accepted and rejected (the mutator reaches past the
+//! parser's first check). Issue 33 item 4: the committed regression corpus
+//! (`tests/fuzz/configs/<format>/`, README there) is rejected the same way, without a panic.
 
 #[path = "../crates/sim/tests/fuzz/mutator.rs"]
 mod mutator;
@@ -37,11 +40,10 @@ fn stroke_seed() -> Vec<u8> {
 /// A parser under test: true if it accepted the text.
 type Parser = fn(&str, &Path) -> bool;
 
-#[test]
-fn mutated_configs_never_panic_hang_or_overallocate() {
-    let count = inputs_per_format();
-    let path = Path::new("fuzz.ron");
-    let formats: [(&str, Vec<Vec<u8>>, Parser); 5] = [
+/// Each format: its name (the corpus folder under `tests/fuzz/configs/`), seed files and
+/// parser.
+fn formats() -> [(&'static str, Vec<Vec<u8>>, Parser); 5] {
+    [
         ("scene", files("config"), |t, p| {
             incise::scene::parse_scene(t, p).is_ok()
         }),
@@ -54,11 +56,17 @@ fn mutated_configs_never_panic_hang_or_overallocate() {
         ("exercise", files("config/exercises"), |t, p| {
             incise::exercise::parse_exercise(t, p).is_ok()
         }),
-        ("headset script", files("config/xr"), |t, p| {
+        ("headset", files("config/xr"), |t, p| {
             incise::xr::script::HeadsetScript::parse(t, p).is_ok()
         }),
-    ];
-    for (k, (name, seeds, parse)) in formats.into_iter().enumerate() {
+    ]
+}
+
+#[test]
+fn mutated_configs_never_panic_hang_or_overallocate() {
+    let count = inputs_per_format();
+    let path = Path::new("fuzz.ron");
+    for (k, (name, seeds, parse)) in formats().into_iter().enumerate() {
         assert!(!seeds.is_empty(), "{name}: no seed files");
         let t = Instant::now();
         let (ok, bad, slowest) = fuzz(name, &seeds, count, 0xC0FF_EE00 + k as u64, SLACK, |b| {
@@ -69,8 +77,54 @@ fn mutated_configs_never_panic_hang_or_overallocate() {
             t.elapsed().as_secs_f64()
         );
         assert!(
-            bad > 0,
-            "{name}: the mutator should produce rejected inputs"
+            ok > 0 && bad > 0,
+            "{name}: the mutants should be both accepted ({ok}) and rejected ({bad})"
         );
+    }
+}
+
+/// The corpus files of `format`, sorted: (path, bytes).
+fn corpus(format: &str) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fuzz/configs")
+        .join(format);
+    let mut out: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            (p.extension()? == "ron").then(|| (p.clone(), std::fs::read(&p).unwrap()))
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn the_regression_corpus_is_rejected_without_a_panic() {
+    let path = Path::new("corpus.ron");
+    for (name, _, parse) in formats() {
+        let cases = corpus(name);
+        assert!(!cases.is_empty(), "{name}: no regression inputs");
+        for (file, bytes) in cases {
+            let t = Instant::now();
+            let accepted = std::panic::catch_unwind(|| {
+                mutator::alloc_meter::peak_during(|| {
+                    std::str::from_utf8(&bytes).is_ok_and(|text| parse(text, path))
+                })
+            });
+            let (accepted, bytes_used) =
+                accepted.unwrap_or_else(|_| panic!("{} panics", file.display()));
+            assert!(!accepted, "{} is accepted", file.display());
+            assert!(
+                bytes_used <= 10 * bytes.len() + SLACK,
+                "{} allocated {bytes_used} bytes",
+                file.display()
+            );
+            assert!(
+                t.elapsed().as_secs_f64() < 1.0,
+                "{} is slow",
+                file.display()
+            );
+        }
     }
 }

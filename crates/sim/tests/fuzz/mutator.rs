@@ -211,7 +211,11 @@ pub fn fuzz(
         let Ok((accepted, bytes)) = result else {
             let path = std::env::temp_dir().join(format!("incise-fuzz-{name}-{k}.bin"));
             let _ = std::fs::write(&path, &input);
-            panic!("{name}: input {k} panicked; saved to {}", path.display());
+            panic!(
+                "{name}: input {k} panicked; saved to {} (keep it as a regression input: \
+                 tests/fuzz/ in this crate or the app, README there)",
+                path.display()
+            );
         };
         assert!(
             bytes <= 10 * input.len() + slack,
