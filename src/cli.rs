@@ -7,8 +7,17 @@ use clap::{Parser, Subcommand, ValueEnum};
 use crate::bench::BenchCase;
 use crate::mesh_cmd::GenKind;
 use crate::pictures::screenshots::{ImageSize, OverlayArg};
+use crate::preview::PreviewOptions;
+use crate::run::RunOptions;
 use crate::sim_body::DeviceChoice;
+use crate::xr::XrOptions;
 use crate::xr::sim_mode::SimChoice;
+
+/// The scene `incise run` and `incise preview` open when none is named.
+pub const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
+
+/// The scene `incise xr` opens when none is named.
+pub const XR_SCENE: &str = "config/plate_cut.ron";
 
 /// incise: mixed-reality surgical cutting trainer (headless runner, mesh tools, benchmarks).
 #[derive(Debug, Parser)]
@@ -24,132 +33,13 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Run a scene headless: report.json, .vtu snapshots and a .pvd collection.
-    Run {
-        /// Scene file (RON), e.g. config/intestine_pull.ron.
-        scene: PathBuf,
-        /// Frames to simulate (default: the scene's duration at its frame rate).
-        #[arg(long)]
-        frames: Option<u64>,
-        /// Output folder.
-        #[arg(long, default_value = "out")]
-        out: PathBuf,
-        /// Write a .vtu snapshot every K frames (0: none).
-        #[arg(long, default_value_t = 10)]
-        vtu_every: u64,
-        /// Solver threads (0: all cores; default: the scene's setting).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// No progress output.
-        #[arg(long)]
-        quiet: bool,
-        /// Where the solver runs (auto: the GPU when an adapter exists, else the CPU).
-        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
-        device: DeviceChoice,
-        /// Write DIR/frame_NNNNN.png every K frames, rendered offscreen (0: none).
-        #[arg(long, default_value_t = 0)]
-        screenshot_every: u64,
-        /// Size of those screenshots, WIDTHxHEIGHT.
-        #[arg(long, default_value = "960x540")]
-        screenshot_size: ImageSize,
-        /// Mass-spring scenes: run the localised loop on its own thread at this rate, Hz
-        /// (e.g. 1000 for a haptic device), with the tool on the scene's blade stroke; the
-        /// report loop runs at the scene's frame rate in real time.
-        #[arg(long, value_parser = positive_rate)]
-        haptic_rate: Option<f64>,
-        /// Drive the scene's scalpel with this stroke file (RON timed poses) instead.
-        #[arg(long)]
-        stroke: Option<PathBuf>,
-        /// Record the scalpel's pose every frame to this stroke file.
-        #[arg(long)]
-        record_stroke: Option<PathBuf>,
-        /// Mass-spring scenes: replay the free nodes of each localised frame of the run that
-        /// wrote this report.json instead of choosing them (a `Budget` scene's manager
-        /// chooses by wall time: the replay reproduces that run bit for bit).
-        #[arg(long, value_name = "REPORT")]
-        replay_localisation: Option<PathBuf>,
-        /// Testing aid: destroy the GPU device just before frame N (the run must go on
-        /// on the CPU with a warning in report.json).
-        #[arg(long, value_name = "N")]
-        inject_gpu_loss_at: Option<u64>,
-        /// Testing aid: give a node a NaN velocity just before frame N (the run must stop
-        /// with the frame and tet named, the frame rolled back, the output kept).
-        #[arg(long, value_name = "N")]
-        inject_nan_at: Option<u64>,
-    },
+    Run(RunArgs),
     /// Open the desktop preview: the scene in a window with a control panel.
-    Preview {
-        /// Scene file (RON); default config/intestine_pull.ron.
-        scene: Option<PathBuf>,
-        /// Render this many frames, then exit.
-        #[arg(long)]
-        frames: Option<u64>,
-        /// Save the window's last frame to this PNG on exit.
-        #[arg(long)]
-        screenshot: Option<PathBuf>,
-        /// Where the solver runs (auto: a hardware GPU if there is one, else the CPU).
-        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
-        device: DeviceChoice,
-        /// Window size, WIDTHxHEIGHT.
-        #[arg(long, default_value = "1280x800")]
-        size: ImageSize,
-        /// Open this exercise (config/exercises/*.ron): its scene, the planned incision
-        /// drawn on the tissue, attempts scored and saved to out/exercises/ and
-        /// results/history.jsonl.
-        #[arg(long, conflicts_with = "scene")]
-        exercise: Option<PathBuf>,
-    },
+    Preview(PreviewArgs),
     /// The scene on a tray in the room of an OpenXR headset (Meta Quest 3 over Link,
     /// WiVRn/Monado), cut with the right controller; exits 2 when no runtime or headset
     /// is usable. `--simulated-headset` runs the same frame loop on a scripted headset.
-    Xr {
-        /// Scene file (RON); default config/plate_cut.ron.
-        scene: Option<PathBuf>,
-        /// Run without a runtime on this headset script (RON: head, controller and
-        /// button tracks), rendering both eyes offscreen.
-        #[arg(long)]
-        simulated_headset: Option<PathBuf>,
-        /// Output folder: frames.csv (frame times), xr_report.json, stroke.ron, eye PNGs.
-        #[arg(long, default_value = "out/xr")]
-        out: PathBuf,
-        /// Also write the recorded scalpel stroke here (replay: `incise run --stroke`).
-        #[arg(long)]
-        record_stroke: Option<PathBuf>,
-        /// Stop after this many display frames.
-        #[arg(long)]
-        frames: Option<u64>,
-        /// Where the solver runs (auto: the headset's GPU; the CPU for a simulated one).
-        #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
-        device: DeviceChoice,
-        /// Training exercise (e.g. config/exercises/slab_depth.ron): its scene with the plan
-        /// drawn on the tissue; A finishes an attempt (scored, saved under OUT/attempts/,
-        /// the result card shown above the tray), A again starts over.
-        #[arg(long, conflicts_with = "scene")]
-        exercise: Option<PathBuf>,
-        /// Results history exercise attempts are appended to.
-        #[arg(long, default_value = "results/history.jsonl")]
-        history: PathBuf,
-        /// Testing aid: give a node a NaN velocity just before simulation frame N (the
-        /// frame is rolled back, an exercise attempt saved, the scene reset).
-        #[arg(long, value_name = "N")]
-        inject_nan_at: Option<u64>,
-        /// Drive the scalpel along this recorded stroke (RON, e.g. a session's stroke.ron)
-        /// in simulation time instead of the right controller, blade engaged; the session
-        /// ends when the stroke has been played (for demos and tests).
-        #[arg(long, value_name = "FILE")]
-        stroke: Option<PathBuf>,
-        /// Where the solver is stepped: on its own thread paced to real time, each display
-        /// frame showing its latest completed state (the display never waits for it), or
-        /// inside each display frame (lockstep, deterministic). auto: the thread, except
-        /// in exercise sessions and on a simulated headset's virtual clock.
-        #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
-        sim: SimChoice,
-        /// Testing aid: sleep N ms in every simulation frame (an artificially slow solver).
-        #[arg(long, value_name = "N", default_value_t = 0, hide = true)]
-        slow_sim_ms: u64,
-        /// Testing aid: panic in the simulation just before simulation frame N.
-        #[arg(long, value_name = "N", hide = true)]
-        inject_sim_panic_at: Option<u64>,
-    },
+    Xr(XrArgs),
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {
         /// Scene file (RON).
@@ -463,5 +353,218 @@ fn positive_rate(s: &str) -> Result<f64, String> {
         Ok(hz)
     } else {
         Err(format!("must be a rate in (0, 100000] Hz, got {s}"))
+    }
+}
+
+/// `incise run`'s arguments.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// Scene file (RON), e.g. config/intestine_pull.ron.
+    pub scene: PathBuf,
+    /// Frames to simulate (default: the scene's duration at its frame rate).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Write a .vtu snapshot every K frames (0: none).
+    #[arg(long, default_value_t = 10)]
+    pub vtu_every: u64,
+    /// Solver threads (0: all cores; default: the scene's setting).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress output.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Where the solver runs (auto: the GPU when an adapter exists, else the CPU).
+    #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+    pub device: DeviceChoice,
+    /// Write DIR/frame_NNNNN.png every K frames, rendered offscreen (0: none).
+    #[arg(long, default_value_t = 0)]
+    pub screenshot_every: u64,
+    /// Size of those screenshots, WIDTHxHEIGHT.
+    #[arg(long, default_value = "960x540")]
+    pub screenshot_size: ImageSize,
+    /// Mass-spring scenes: run the localised loop on its own thread at this rate, Hz
+    /// (e.g. 1000 for a haptic device), with the tool on the scene's blade stroke; the
+    /// report loop runs at the scene's frame rate in real time.
+    #[arg(long, value_parser = positive_rate)]
+    pub haptic_rate: Option<f64>,
+    /// Drive the scene's scalpel with this stroke file (RON timed poses) instead.
+    #[arg(long)]
+    pub stroke: Option<PathBuf>,
+    /// Record the scalpel's pose every frame to this stroke file.
+    #[arg(long)]
+    pub record_stroke: Option<PathBuf>,
+    /// Mass-spring scenes: replay the free nodes of each localised frame of the run that
+    /// wrote this report.json instead of choosing them (a `Budget` scene's manager
+    /// chooses by wall time: the replay reproduces that run bit for bit).
+    #[arg(long, value_name = "REPORT")]
+    pub replay_localisation: Option<PathBuf>,
+    /// Testing aid: destroy the GPU device just before frame N (the run must go on
+    /// on the CPU with a warning in report.json).
+    #[arg(long, value_name = "N")]
+    pub inject_gpu_loss_at: Option<u64>,
+    /// Testing aid: give a node a NaN velocity just before frame N (the run must stop
+    /// with the frame and tet named, the frame rolled back, the output kept).
+    #[arg(long, value_name = "N")]
+    pub inject_nan_at: Option<u64>,
+}
+
+/// `incise preview`'s arguments.
+#[derive(Debug, Clone, clap::Args)]
+pub struct PreviewArgs {
+    /// Scene file (RON); default config/intestine_pull.ron.
+    pub scene: Option<PathBuf>,
+    /// Render this many frames, then exit.
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Save the window's last frame to this PNG on exit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Where the solver runs (auto: a hardware GPU if there is one, else the CPU).
+    #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+    pub device: DeviceChoice,
+    /// Window size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x800")]
+    pub size: ImageSize,
+    /// Open this exercise (config/exercises/*.ron): its scene, the planned incision
+    /// drawn on the tissue, attempts scored and saved to out/exercises/ and
+    /// results/history.jsonl.
+    #[arg(long, conflicts_with = "scene")]
+    pub exercise: Option<PathBuf>,
+}
+
+/// `incise xr`'s arguments.
+#[derive(Debug, Clone, clap::Args)]
+pub struct XrArgs {
+    /// Scene file (RON); default config/plate_cut.ron.
+    pub scene: Option<PathBuf>,
+    /// Run without a runtime on this headset script (RON: head, controller and
+    /// button tracks), rendering both eyes offscreen.
+    #[arg(long)]
+    pub simulated_headset: Option<PathBuf>,
+    /// Output folder: frames.csv (frame times), xr_report.json, stroke.ron, eye PNGs.
+    #[arg(long, default_value = "out/xr")]
+    pub out: PathBuf,
+    /// Also write the recorded scalpel stroke here (replay: `incise run --stroke`).
+    #[arg(long)]
+    pub record_stroke: Option<PathBuf>,
+    /// Stop after this many display frames.
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Where the solver runs (auto: the headset's GPU; the CPU for a simulated one).
+    #[arg(long, value_enum, default_value_t = DeviceChoice::Auto)]
+    pub device: DeviceChoice,
+    /// Training exercise (e.g. config/exercises/slab_depth.ron): its scene with the plan
+    /// drawn on the tissue; A finishes an attempt (scored, saved under OUT/attempts/,
+    /// the result card shown above the tray), A again starts over.
+    #[arg(long, conflicts_with = "scene")]
+    pub exercise: Option<PathBuf>,
+    /// Results history exercise attempts are appended to.
+    #[arg(long, default_value = "results/history.jsonl")]
+    pub history: PathBuf,
+    /// Testing aid: give a node a NaN velocity just before simulation frame N (the
+    /// frame is rolled back, an exercise attempt saved, the scene reset).
+    #[arg(long, value_name = "N")]
+    pub inject_nan_at: Option<u64>,
+    /// Drive the scalpel along this recorded stroke (RON, e.g. a session's stroke.ron)
+    /// in simulation time instead of the right controller, blade engaged; the session
+    /// ends when the stroke has been played (for demos and tests).
+    #[arg(long, value_name = "FILE")]
+    pub stroke: Option<PathBuf>,
+    /// Where the solver is stepped: on its own thread paced to real time, each display
+    /// frame showing its latest completed state (the display never waits for it), or
+    /// inside each display frame (lockstep, deterministic). auto: the thread, except
+    /// in exercise sessions and on a simulated headset's virtual clock.
+    #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
+    pub sim: SimChoice,
+    /// Testing aid: sleep N ms in every simulation frame (an artificially slow solver).
+    #[arg(long, value_name = "N", default_value_t = 0, hide = true)]
+    pub slow_sim_ms: u64,
+    /// Testing aid: panic in the simulation just before simulation frame N.
+    #[arg(long, value_name = "N", hide = true)]
+    pub inject_sim_panic_at: Option<u64>,
+}
+
+impl From<RunArgs> for RunOptions {
+    fn from(a: RunArgs) -> Self {
+        RunOptions {
+            scene: a.scene,
+            frames: a.frames,
+            out: a.out,
+            vtu_every: a.vtu_every,
+            threads: a.threads,
+            quiet: a.quiet,
+            device: a.device,
+            screenshot_every: a.screenshot_every,
+            screenshot_size: a.screenshot_size,
+            haptic_rate: a.haptic_rate,
+            stroke: a.stroke,
+            record_stroke: a.record_stroke,
+            replay_localisation: a.replay_localisation,
+            inject_gpu_loss_at: a.inject_gpu_loss_at,
+            inject_nan_at: a.inject_nan_at,
+            screenshot_decal: None,
+        }
+    }
+}
+
+impl From<PreviewArgs> for PreviewOptions {
+    fn from(a: PreviewArgs) -> Self {
+        PreviewOptions {
+            scene: a.scene.unwrap_or_else(|| DEFAULT_SCENE.into()),
+            frames: a.frames,
+            screenshot: a.screenshot,
+            device: a.device,
+            size: a.size,
+            exercise: a.exercise,
+        }
+    }
+}
+
+impl From<XrArgs> for XrOptions {
+    fn from(a: XrArgs) -> Self {
+        XrOptions {
+            scene: a.scene.unwrap_or_else(|| XR_SCENE.into()),
+            simulated: a.simulated_headset,
+            out: a.out,
+            record_stroke: a.record_stroke,
+            frames: a.frames,
+            device: a.device,
+            exercise: a.exercise,
+            history: a.history,
+            inject_nan_at: a.inject_nan_at,
+            stroke: a.stroke,
+            sim: a.sim,
+            slow_sim_ms: a.slow_sim_ms,
+            inject_sim_panic_at: a.inject_sim_panic_at,
+        }
+    }
+}
+
+impl Command {
+    /// What `incise` with no subcommand does: the preview of [`DEFAULT_SCENE`] when a
+    /// window can open, else the headless run of it into out/intestine_pull (as
+    /// scripts/run.sh), saying why. Each is the command line it stands for, parsed.
+    pub fn default_for_this_machine() -> Command {
+        let line: &[&str] = match crate::preview::display::missing_display() {
+            None => &["incise", "preview"],
+            Some(why) => {
+                eprintln!(
+                    "{why}: running {DEFAULT_SCENE} headless (`incise --help` lists the commands)"
+                );
+                &[
+                    "incise",
+                    "run",
+                    DEFAULT_SCENE,
+                    "--out",
+                    "out/intestine_pull",
+                ]
+            }
+        };
+        Cli::parse_from(line)
+            .command
+            .expect("the default command line names a command")
     }
 }

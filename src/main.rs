@@ -6,149 +6,30 @@ use clap::Parser;
 use incise::bench::{self, realtime as bench_realtime, render as bench_render};
 use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
 use incise::pictures::render_command;
-use incise::pictures::screenshots::ImageSize;
-use incise::preview::{self, PreviewOptions};
-use incise::run::{RunOptions, run_scene};
+use incise::preview;
+use incise::run::run_scene;
 use incise::{compare, exercise, experiment, mesh_cmd};
-
-/// The scene opened when none is named.
-const DEFAULT_SCENE: &str = "config/intestine_pull.ron";
-
-/// The scene `incise xr` opens when none is named.
-const XR_SCENE: &str = "config/plate_cut.ron";
-
-/// No subcommand: the preview of the default scene when a window can open, else the
-/// headless run of it (as scripts/run.sh), saying so.
-fn default_command() -> Command {
-    match preview::display::missing_display() {
-        None => Command::Preview {
-            scene: None,
-            frames: None,
-            screenshot: None,
-            device: incise::sim_body::DeviceChoice::Auto,
-            size: ImageSize(1280, 800),
-            exercise: None,
-        },
-        Some(why) => {
-            eprintln!(
-                "{why}: running {DEFAULT_SCENE} headless (`incise --help` lists the commands)"
-            );
-            Command::Run {
-                scene: DEFAULT_SCENE.into(),
-                frames: None,
-                out: "out/intestine_pull".into(),
-                vtu_every: 10,
-                threads: None,
-                quiet: false,
-                device: incise::sim_body::DeviceChoice::Auto,
-                screenshot_every: 0,
-                screenshot_size: ImageSize(960, 540),
-                haptic_rate: None,
-                stroke: None,
-                record_stroke: None,
-                replay_localisation: None,
-                inject_gpu_loss_at: None,
-                inject_nan_at: None,
-            }
-        }
-    }
-}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let command = cli.command.unwrap_or_else(default_command);
+    let command = cli
+        .command
+        .unwrap_or_else(Command::default_for_this_machine);
     // The commands that stop gracefully on Ctrl-C (outputs written, exit 130 or a clean
     // XR session end); the others keep the default (the process dies).
     if matches!(
         command,
-        Command::Run { .. } | Command::Xr { .. } | Command::Exercise { .. }
+        Command::Run(_) | Command::Xr(_) | Command::Exercise { .. }
     ) {
         incise::interrupt::install();
     }
     let result = match command {
-        Command::Run {
-            scene,
-            frames,
-            out,
-            vtu_every,
-            threads,
-            quiet,
-            device,
-            screenshot_every,
-            screenshot_size,
-            haptic_rate,
-            stroke,
-            record_stroke,
-            replay_localisation,
-            inject_gpu_loss_at,
-            inject_nan_at,
-        } => run_scene(&RunOptions {
-            scene,
-            frames,
-            out,
-            vtu_every,
-            threads,
-            quiet,
-            device,
-            screenshot_every,
-            screenshot_size,
-            haptic_rate,
-            stroke,
-            record_stroke,
-            replay_localisation,
-            inject_gpu_loss_at,
-            inject_nan_at,
-            screenshot_decal: None,
-        })
-        .map(|o| {
+        Command::Run(args) => run_scene(&args.into()).map(|o| {
             println!("{}", o.report.summary());
             println!("report: {}", o.report_path.display());
         }),
-        Command::Preview {
-            scene,
-            frames,
-            screenshot,
-            device,
-            size,
-            exercise,
-        } => preview::run(PreviewOptions {
-            scene: scene.unwrap_or_else(|| DEFAULT_SCENE.into()),
-            frames,
-            screenshot,
-            device,
-            size,
-            exercise,
-        }),
-        Command::Xr {
-            scene,
-            simulated_headset,
-            out,
-            record_stroke,
-            frames,
-            device,
-            exercise,
-            history,
-            inject_nan_at,
-            stroke,
-            sim,
-            slow_sim_ms,
-            inject_sim_panic_at,
-        } => incise::xr::run(&incise::xr::XrOptions {
-            scene: scene.unwrap_or_else(|| XR_SCENE.into()),
-            simulated: simulated_headset,
-            out,
-            record_stroke,
-            frames,
-            device,
-            exercise,
-            history,
-            inject_nan_at,
-            stroke,
-            sim,
-            slow_sim_ms,
-            inject_sim_panic_at,
-        })
-        .map(|summary| println!("{summary}")),
+        Command::Preview(args) => preview::run(args.into()),
+        Command::Xr(args) => incise::xr::run(&args.into()).map(|summary| println!("{summary}")),
         Command::Render {
             scene,
             frame,
@@ -222,15 +103,13 @@ fn main() -> ExitCode {
             scaling,
             markdown,
             ..
-        } => {
-            bench::run(
-                case,
-                frames,
-                bench::BenchOutput::of(json, markdown),
-                device,
-                scaling,
-            )
-        }
+        } => bench::run(
+            case,
+            frames,
+            bench::BenchOutput::of(json, markdown),
+            device,
+            scaling,
+        ),
         Command::Soak {
             scene,
             seconds,
@@ -243,35 +122,7 @@ fn main() -> ExitCode {
             device,
             out: out.clone(),
         })
-        .and_then(|r| {
-            let last = r.cycles.last();
-            println!(
-                "{} cuts in {:.0} s on {}: memory {:+.1} % (peak {:+.1} %), descriptors {:+}, p99 frame {:.1} ms (last cut), every cut {} the first",
-                r.cycles.len(),
-                r.seconds,
-                r.device,
-                r.rss_growth * 100.0,
-                r.rss_peak_growth * 100.0,
-                r.fd_growth,
-                last.map_or(0.0, |c| c.p99_ms),
-                if r.cycles.iter().all(|c| c.matches_first) { "matches" } else { "differs from" },
-            );
-            if r.replayed_free_nodes > 0 {
-                println!(
-                    "later cuts replayed the first cut's free-node counts ({} localised frames)",
-                    r.replayed_free_nodes
-                );
-            }
-            println!("report: {}", out.join("soak.json").display());
-            if markdown {
-                print!("\n{}", incise::bench::soak::markdown(&r));
-            }
-            if r.passed {
-                Ok(())
-            } else {
-                Err(anyhow::anyhow!("soak failed: {}", r.problems.join("; ")))
-            }
-        }),
+        .and_then(|r| incise::bench::soak::conclude(&r, &out, markdown)),
         Command::Exercise {
             exercise,
             reference_stroke: Some(file),

@@ -332,6 +332,42 @@ fn judge(cycles: &[SoakCycle]) -> Verdict {
     }
 }
 
+/// Print the soak's outcome (the summary line, the replay note, the report's path and
+/// with `markdown` the docs table) and fail naming the problems when it did not pass.
+pub fn conclude(r: &SoakReport, out: &Path, markdown: bool) -> Result<()> {
+    let last = r.cycles.last();
+    println!(
+        "{} cuts in {:.0} s on {}: memory {:+.1} % (peak {:+.1} %), descriptors {:+}, p99 frame {:.1} ms (last cut), every cut {} the first",
+        r.cycles.len(),
+        r.seconds,
+        r.device,
+        r.rss_growth * 100.0,
+        r.rss_peak_growth * 100.0,
+        r.fd_growth,
+        last.map_or(0.0, |c| c.p99_ms),
+        if r.cycles.iter().all(|c| c.matches_first) {
+            "matches"
+        } else {
+            "differs from"
+        },
+    );
+    if r.replayed_free_nodes > 0 {
+        println!(
+            "later cuts replayed the first cut's free-node counts ({} localised frames)",
+            r.replayed_free_nodes
+        );
+    }
+    println!("report: {}", out.join("soak.json").display());
+    if markdown {
+        print!("\n{}", self::markdown(r));
+    }
+    if r.passed {
+        Ok(())
+    } else {
+        Err(anyhow!("soak failed: {}", r.problems.join("; ")))
+    }
+}
+
 /// The report as one row of docs/reliability.md's soak table, under the line saying
 /// which command made it, where and when.
 pub fn markdown(r: &SoakReport) -> String {
