@@ -9,6 +9,7 @@ use crate::mesh_cmd::GenKind;
 use crate::pictures::screenshots::{ImageSize, OverlayArg};
 use crate::preview::PreviewOptions;
 use crate::run::RunOptions;
+use crate::scene::built_in::resolve;
 use crate::sim_body::DeviceChoice;
 use crate::xr::XrOptions;
 use crate::xr::sim_mode::SimChoice;
@@ -168,6 +169,13 @@ pub enum Command {
         /// No progress output.
         #[arg(long)]
         quiet: bool,
+    },
+    /// List the built-in scenes and exercises (each runs by name from any directory, e.g.
+    /// `incise run intestine_pull`), or export the built-in config tree to edit.
+    Scenes {
+        /// What to do (none: list them).
+        #[command(subcommand)]
+        action: Option<ScenesAction>,
     },
     /// Print the results history as a table, oldest attempt first.
     Results {
@@ -490,7 +498,7 @@ pub struct XrArgs {
 impl From<RunArgs> for RunOptions {
     fn from(a: RunArgs) -> Self {
         RunOptions {
-            scene: a.scene,
+            scene: resolve(&a.scene),
             frames: a.frames,
             out: a.out,
             vtu_every: a.vtu_every,
@@ -513,12 +521,12 @@ impl From<RunArgs> for RunOptions {
 impl From<PreviewArgs> for PreviewOptions {
     fn from(a: PreviewArgs) -> Self {
         PreviewOptions {
-            scene: a.scene.unwrap_or_else(|| DEFAULT_SCENE.into()),
+            scene: resolve(&a.scene.unwrap_or_else(|| DEFAULT_SCENE.into())),
             frames: a.frames,
             screenshot: a.screenshot,
             device: a.device,
             size: a.size,
-            exercise: a.exercise,
+            exercise: a.exercise.as_deref().map(resolve),
         }
     }
 }
@@ -526,13 +534,13 @@ impl From<PreviewArgs> for PreviewOptions {
 impl From<XrArgs> for XrOptions {
     fn from(a: XrArgs) -> Self {
         XrOptions {
-            scene: a.scene.unwrap_or_else(|| XR_SCENE.into()),
-            simulated: a.simulated_headset,
+            scene: resolve(&a.scene.unwrap_or_else(|| XR_SCENE.into())),
+            simulated: a.simulated_headset.as_deref().map(resolve),
             out: a.out,
             record_stroke: a.record_stroke,
             frames: a.frames,
             device: a.device,
-            exercise: a.exercise,
+            exercise: a.exercise.as_deref().map(resolve),
             history: a.history,
             inject_nan_at: a.inject_nan_at,
             stroke: a.stroke,
@@ -567,4 +575,15 @@ impl Command {
             .command
             .expect("the default command line names a command")
     }
+}
+
+/// `incise scenes` subcommands.
+#[derive(Debug, Subcommand)]
+pub enum ScenesAction {
+    /// Write the built-in config tree (scenes, exercises, presets, tools, strokes, headset
+    /// scripts) into DIR, to edit and run from there.
+    Export {
+        /// Folder to write into (created; files of the same names are replaced).
+        dir: PathBuf,
+    },
 }

@@ -4,10 +4,11 @@ use std::process::ExitCode;
 
 use clap::Parser;
 use incise::bench::{self, realtime as bench_realtime, render as bench_render};
-use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand};
+use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand, ScenesAction};
 use incise::pictures::render_command;
 use incise::preview;
 use incise::run::run_scene;
+use incise::scene::built_in::{self, resolve};
 use incise::{compare, exercise, experiment, mesh_cmd};
 
 fn main() -> ExitCode {
@@ -37,14 +38,14 @@ fn main() -> ExitCode {
             size,
             overlay,
             device,
-        } => render_command::render_frame(&scene, frame, &out, size, &overlay, device)
+        } => render_command::render_frame(&resolve(&scene), frame, &out, size, &overlay, device)
             .map(|()| println!("wrote {}", out.display())),
         Command::Compare {
             scene,
             frames,
             threads,
             json,
-        } => compare::run(&scene, frames, threads, json),
+        } => compare::run(&resolve(&scene), frames, threads, json),
         Command::Mesh { command } => match command {
             MeshCommand::Check { file, json } => mesh_cmd::check(&file, json),
             MeshCommand::Gen { kind, out } => mesh_cmd::generate(kind, &out),
@@ -70,7 +71,7 @@ fn main() -> ExitCode {
             markdown,
             ..
         } => bench_realtime::run(
-            &scene,
+            &resolve(&scene),
             device,
             (
                 threads,
@@ -89,7 +90,7 @@ fn main() -> ExitCode {
             markdown,
             ..
         } => bench::scene::run(
-            &scene,
+            &resolve(&scene),
             device,
             frames,
             bench::BenchOutput::of(json, markdown),
@@ -117,7 +118,7 @@ fn main() -> ExitCode {
             out,
             markdown,
         } => incise::bench::soak::run(&incise::bench::soak::SoakOptions {
-            scene,
+            scene: resolve(&scene),
             seconds,
             device,
             out: out.clone(),
@@ -128,7 +129,7 @@ fn main() -> ExitCode {
             reference_stroke: Some(file),
             tilt,
             ..
-        } => exercise::write_reference_stroke(&exercise, &file, tilt).map(|()| {
+        } => exercise::write_reference_stroke(&resolve(&exercise), &file, tilt).map(|()| {
             println!("wrote {}", file.display());
         }),
         Command::Exercise {
@@ -140,8 +141,8 @@ fn main() -> ExitCode {
             quiet,
             ..
         } => exercise::run_exercise(&exercise::ExerciseOptions {
-            exercise,
-            stroke,
+            exercise: resolve(&exercise),
+            stroke: resolve(&stroke),
             out,
             device,
             history: history.clone(),
@@ -156,6 +157,17 @@ fn main() -> ExitCode {
         Command::Exercise { .. } => Err(anyhow::anyhow!(
             "incise exercise needs --stroke FILE (or --reference-stroke FILE)"
         )),
+        Command::Scenes { action: None } => {
+            for (name, _, about) in built_in::scenes() {
+                println!("{name:<32} {about}");
+            }
+            Ok(())
+        }
+        Command::Scenes {
+            action: Some(ScenesAction::Export { dir }),
+        } => built_in::export(&dir)
+            .map(|n| println!("wrote {n} files to {}", dir.display()))
+            .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display())),
         Command::Results { history } => exercise::read_history(&history)
             .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {
