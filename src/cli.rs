@@ -177,6 +177,10 @@ pub enum Command {
         #[command(subcommand)]
         action: Option<ScenesAction>,
     },
+    /// What this machine offers the trainer: GPU adapters (and which one `--device auto`
+    /// picks), Vulkan, the OpenXR loader and runtime, a headset, a display for the
+    /// preview; each ok or missing with the fix. Exits 1 when the headset path cannot work.
+    Doctor,
     /// Print the results history as a table, oldest attempt first.
     Results {
         /// Results history file.

@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod cli;
 pub mod compare;
+pub mod doctor;
 pub mod exercise;
 pub mod experiment;
 pub mod interrupt;

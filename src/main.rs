@@ -168,6 +168,15 @@ fn main() -> ExitCode {
         } => built_in::export(&dir)
             .map(|n| println!("wrote {n} files to {}", dir.display()))
             .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display())),
+        Command::Doctor => {
+            let checks = incise::doctor::checks();
+            print!("{}", incise::doctor::report(&checks));
+            if incise::doctor::headset_ready(&checks) {
+                Ok(())
+            } else {
+                return ExitCode::FAILURE;
+            }
+        }
         Command::Results { history } => exercise::read_history(&history)
             .map(|entries| print!("{}", exercise::history_table(&entries))),
         Command::Experiment { command } => match command {

@@ -45,7 +45,10 @@ fn the_built_in_tree_is_the_config_folder() {
     let on_disk = ron_files(&config);
     let mut built: Vec<PathBuf> = built_in::FILES.iter().map(|(p, _)| p.into()).collect();
     built.sort();
-    assert_eq!(built, on_disk, "src/scene/built_in.rs FILES must list config/");
+    assert_eq!(
+        built, on_disk,
+        "src/scene/built_in.rs FILES must list config/"
+    );
     for (path, text) in built_in::FILES {
         let disk = std::fs::read_to_string(config.join(path)).unwrap();
         assert_eq!(*text, disk, "{path}");
@@ -62,7 +65,10 @@ fn shipped_scenes_run_by_name_and_by_config_path_from_any_directory() {
     for name in ["intestine_pull ", "plate_cut ", "exercises/slab_depth "] {
         assert!(listed.contains(name), "{name} not listed:\n{listed}");
     }
-    assert!(!listed.contains("materials"), "presets are not scenes:\n{listed}");
+    assert!(
+        !listed.contains("materials"),
+        "presets are not scenes:\n{listed}"
+    );
 
     for scene in ["plate_cut", "config/plate_cut.ron"] {
         let out = dir.join("out");
@@ -112,5 +118,8 @@ fn scenes_export_writes_the_tree_to_edit() {
     let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
     assert_eq!(ron_files(&dir.join("mine")), ron_files(&config));
     let a = std::fs::read(dir.join("mine/tools/scalpel_10.ron")).unwrap();
-    assert_eq!(a, std::fs::read(config.join("tools/scalpel_10.ron")).unwrap());
+    assert_eq!(
+        a,
+        std::fs::read(config.join("tools/scalpel_10.ron")).unwrap()
+    );
 }

@@ -200,6 +200,7 @@ const APP_LAYERS: &[&str] = &[
     "bench",
     "xr",
     "preview",
+    "doctor",
     "cli",
 ];
 

@@ -83,3 +83,20 @@ fn instance_without(left_out: &[&CStr]) -> Option<wgpu::Instance> {
         Some(wgpu::Instance::from_hal::<wgpu::hal::api::Vulkan>(hal))
     }
 }
+
+/// The Vulkan loader's instance version as "major.minor.patch", or `None` where no Vulkan
+/// loader can be loaded (`incise doctor`).
+pub fn loader_version() -> Option<String> {
+    // SAFETY: loading the system Vulkan loader; only its version is queried.
+    let entry = unsafe { ash::Entry::load() }.ok()?;
+    // SAFETY: a plain query of the loaded entry.
+    let v = unsafe { entry.try_enumerate_instance_version() }
+        .ok()?
+        .unwrap_or(vk::API_VERSION_1_0);
+    Some(format!(
+        "{}.{}.{}",
+        vk::api_version_major(v),
+        vk::api_version_minor(v),
+        vk::api_version_patch(v)
+    ))
+}
