@@ -142,6 +142,16 @@ fn headset() -> Check {
 
 fn runtime_manifest() -> Check {
     let active = ActiveRuntime::find();
+    if cfg!(windows) && active.path().is_none() {
+        // The loader reads the active runtime from the registry there
+        // (HKLM\SOFTWARE\Khronos\OpenXR\1\ActiveRuntime); the headset check opens it.
+        return Check::ok(
+            "runtime manifest",
+            "registered in the Windows registry (the OpenXR headset line says whether it loads)"
+                .into(),
+            false,
+        );
+    }
     match active.path() {
         Some(p) if p.exists() => Check::ok("runtime manifest", active.describe(), false),
         _ => Check::missing(

@@ -16,12 +16,9 @@ pub struct Provenance {
 
 /// This machine, now, and its load.
 pub fn provenance() -> Provenance {
-    let date = std::process::Command::new("date")
-        .args(["-u", "+%Y-%m-%d %H:%M UTC"])
-        .output()
-        .ok()
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-        .unwrap_or_else(|| "unknown".into());
+    let date = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or_else(|_| "unknown".into(), |d| utc_minute(d.as_secs()));
     let load = std::fs::read_to_string("/proc/loadavg")
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
         .unwrap_or_else(|_| "unknown".into());
@@ -30,6 +27,23 @@ pub fn provenance() -> Provenance {
         date_utc: date,
         load_average: load,
     }
+}
+
+/// `secs` since the Unix epoch as "YYYY-MM-DD HH:MM UTC" (the civil date from the day
+/// count, H. Hinnant's `civil_from_days`), without a `date` command (Windows has none).
+pub fn utc_minute(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let (hour, minute) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02} {hour:02}:{minute:02} UTC")
 }
 
 /// The command line this process was started with, as `incise ARGS`.
@@ -64,4 +78,18 @@ pub fn machine() -> String {
         .unwrap_or_else(|| "unknown CPU".into());
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     format!("{model}, {cores} logical cores")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utc_minutes_are_civil_dates() {
+        assert_eq!(utc_minute(0), "1970-01-01 00:00 UTC");
+        // 2000-02-29 12:34 UTC (a leap day of a century leap year).
+        assert_eq!(utc_minute(951_827_640), "2000-02-29 12:34 UTC");
+        // 2026-12-04 22:20 UTC.
+        assert_eq!(utc_minute(1_796_422_800), "2026-12-04 22:20 UTC");
+    }
 }

@@ -203,15 +203,21 @@ fn built_in_path(arg: &Path) -> Option<&'static str> {
         .find(|path| *path == with_ext)
 }
 
-/// Where the built-in tree is exported: the user's cache folder, one folder per content
+/// Where the built-in tree is exported: the user's cache folder (`$XDG_CACHE_HOME`,
+/// `%LOCALAPPDATA%` on Windows, `~/.cache`, else the temp folder), one folder per content
 /// of the tree (so a newer incise never reads an older export).
 fn cache_dir() -> PathBuf {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
     FILES.hash(&mut h);
-    let base = std::env::var_os("XDG_CACHE_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+    let var = |v: &str| {
+        std::env::var_os(v)
+            .filter(|s| !s.is_empty())
+            .map(PathBuf::from)
+    };
+    let base = var("XDG_CACHE_HOME")
+        .or_else(|| var("LOCALAPPDATA"))
+        .or_else(|| var("HOME").map(|h| h.join(".cache")))
         .unwrap_or_else(std::env::temp_dir);
     base.join("incise")
         .join(format!("config-{:016x}", h.finish()))
