@@ -29,11 +29,17 @@ pub fn provenance() -> Provenance {
     }
 }
 
-/// `secs` since the Unix epoch as "YYYY-MM-DD HH:MM UTC" (the civil date from the day
-/// count, H. Hinnant's `civil_from_days`), without a `date` command (Windows has none).
+/// `secs` since the Unix epoch as "YYYY-MM-DD HH:MM UTC", without a `date` command
+/// (Windows has none).
 pub fn utc_minute(secs: u64) -> String {
-    let days = (secs / 86_400) as i64;
+    let (year, month, day) = civil_from_days((secs / 86_400) as i64);
     let (hour, minute) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
+    format!("{year:04}-{month:02}-{day:02} {hour:02}:{minute:02} UTC")
+}
+
+/// The (year, month, day) of `days` since 1970-01-01 (Howard Hinnant's
+/// `civil_from_days`, proleptic Gregorian).
+pub fn civil_from_days(days: i64) -> (i64, i64, i64) {
     let z = days + 719_468;
     let era = z.div_euclid(146_097);
     let doe = z - era * 146_097;
@@ -42,8 +48,7 @@ pub fn utc_minute(secs: u64) -> String {
     let mp = (5 * doy + 2) / 153;
     let day = doy - (153 * mp + 2) / 5 + 1;
     let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + i64::from(month <= 2);
-    format!("{year:04}-{month:02}-{day:02} {hour:02}:{minute:02} UTC")
+    (yoe + era * 400 + i64::from(month <= 2), month, day)
 }
 
 /// The command line this process was started with, as `incise ARGS`.

@@ -10,7 +10,7 @@ mod common;
 
 use std::process::{Command, Output};
 
-use common::{temp_dir, text};
+use common::{incise_command, temp_dir, text};
 use incise_test_gate::{Need, skip_or_fail};
 
 /// Lines of `o`'s stdout and stderr that start with `error:` (any case).
@@ -36,12 +36,6 @@ fn assert_clean(what: &str, mut cmd: Command) -> Output {
     o
 }
 
-fn incise(args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_incise"));
-    c.args(args);
-    c
-}
-
 #[test]
 fn the_preview_without_xdg_runtime_dir_prints_no_error() {
     if Command::new("xvfb-run").arg("--help").output().is_err() {
@@ -64,7 +58,7 @@ fn headless_commands_without_xdg_runtime_dir_print_no_error() {
     let (run, png, xr) = (out("run"), out("plate.png"), out("xr"));
     assert_clean(
         "incise run",
-        incise(&[
+        incise_command(&[
             "run",
             "config/plate_cut.ron",
             "--frames",
@@ -75,11 +69,11 @@ fn headless_commands_without_xdg_runtime_dir_print_no_error() {
     );
     assert_clean(
         "incise render",
-        incise(&["render", "config/plate_cut.ron", &png]),
+        incise_command(&["render", "config/plate_cut.ron", &png]),
     );
     assert_clean(
         "incise xr --simulated-headset",
-        incise(&[
+        incise_command(&[
             "xr",
             "config/plate_cut.ron",
             "--simulated-headset",

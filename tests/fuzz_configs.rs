@@ -19,17 +19,26 @@ static METER: Meter = Meter;
 /// Fixed-size allocations (error strings, the parser's own tables).
 const SLACK: usize = 256 * 1024;
 
-fn files(dir: &str) -> Vec<Vec<u8>> {
+/// The `.ron` files directly in `dir` (under the workspace), sorted: (path, bytes).
+fn ron_files(dir: &Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
-    let mut out: Vec<Vec<u8>> = std::fs::read_dir(&root)
-        .unwrap()
+    let mut out: Vec<_> = std::fs::read_dir(&root)
+        .unwrap_or_else(|e| panic!("{}: {e}", root.display()))
         .filter_map(|e| {
             let p = e.ok()?.path();
-            (p.extension()? == "ron").then(|| std::fs::read(&p).ok())?
+            (p.extension()? == "ron").then(|| (p.clone(), std::fs::read(&p).unwrap()))
         })
         .collect();
     out.sort();
     out
+}
+
+/// The seed texts in `dir`.
+fn files(dir: &str) -> Vec<Vec<u8>> {
+    ron_files(Path::new(dir))
+        .into_iter()
+        .map(|(_, b)| b)
+        .collect()
 }
 
 fn stroke_seed() -> Vec<u8> {
@@ -83,27 +92,11 @@ fn mutated_configs_never_panic_hang_or_overallocate() {
     }
 }
 
-/// The corpus files of `format`, sorted: (path, bytes).
-fn corpus(format: &str) -> Vec<(std::path::PathBuf, Vec<u8>)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/fuzz/configs")
-        .join(format);
-    let mut out: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .filter_map(|e| {
-            let p = e.ok()?.path();
-            (p.extension()? == "ron").then(|| (p.clone(), std::fs::read(&p).unwrap()))
-        })
-        .collect();
-    out.sort();
-    out
-}
-
 #[test]
 fn the_regression_corpus_is_rejected_without_a_panic() {
     let path = Path::new("corpus.ron");
     for (name, _, parse) in formats() {
-        let cases = corpus(name);
+        let cases = ron_files(&Path::new("tests/fuzz/configs").join(name));
         assert!(!cases.is_empty(), "{name}: no regression inputs");
         for (file, bytes) in cases {
             let t = Instant::now();

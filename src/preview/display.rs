@@ -3,15 +3,18 @@
 
 /// Why no window can be opened here, or `None` when one can.
 pub fn missing_display() -> Option<&'static str> {
-    if cfg!(any(
+    let unix_desktop = cfg!(any(
         target_os = "linux",
         target_os = "freebsd",
         target_os = "openbsd"
-    )) {
-        let set = |v: &str| std::env::var_os(v).is_some_and(|s| !s.is_empty());
-        if !set("DISPLAY") && !set("WAYLAND_DISPLAY") {
-            return Some("no display (neither DISPLAY nor WAYLAND_DISPLAY is set)");
-        }
+    ));
+    if unix_desktop && !env_set("DISPLAY") && !env_set("WAYLAND_DISPLAY") {
+        return Some("no display (neither DISPLAY nor WAYLAND_DISPLAY is set)");
     }
     None
+}
+
+/// Whether the environment variable `name` is set and not empty.
+pub fn env_set(name: &str) -> bool {
+    std::env::var_os(name).is_some_and(|s| !s.is_empty())
 }

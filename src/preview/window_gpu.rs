@@ -8,6 +8,8 @@ use anyhow::{Result, anyhow};
 use incise_xr::{BodyState, RenderDevice, RenderSettings, Renderer, RgbaImage, View};
 use winit::window::Window;
 
+use super::display::env_set;
+
 /// The egui output of one frame, ready to draw.
 pub struct PanelFrame {
     /// Tessellated shapes.
@@ -206,15 +208,14 @@ fn open_on(
 /// not set" (issue 34 item 3); `None` elsewhere (wgpu's own instance is used).
 fn x11_instance(window: &Arc<Window>) -> Option<wgpu::Instance> {
     use winit::raw_window_handle::{HasWindowHandle, RawWindowHandle};
-    let set = |v: &str| std::env::var_os(v).is_some_and(|s| !s.is_empty());
     let x11 = window.window_handle().is_ok_and(|h| {
         matches!(
             h.as_raw(),
             RawWindowHandle::Xlib(_) | RawWindowHandle::Xcb(_)
         )
     });
-    let wayland = set("WAYLAND_DISPLAY") || set("WAYLAND_SOCKET");
-    if x11 && !wayland && !set("WGPU_BACKEND") {
+    let wayland = env_set("WAYLAND_DISPLAY") || env_set("WAYLAND_SOCKET");
+    if x11 && !wayland && !env_set("WGPU_BACKEND") {
         incise_xr::vulkan_instance::x11_instance()
     } else {
         None

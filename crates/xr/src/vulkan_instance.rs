@@ -44,10 +44,7 @@ fn instance_without(left_out: &[&CStr]) -> Option<wgpu::Instance> {
     // surface use) and takes ownership of the instance (no drop callback).
     unsafe {
         let entry = ash::Entry::load().ok()?;
-        let version = entry
-            .try_enumerate_instance_version()
-            .ok()?
-            .unwrap_or(vk::API_VERSION_1_0);
+        let version = instance_version(&entry).ok()?;
         if version < vk::API_VERSION_1_1 {
             return None;
         }
@@ -56,10 +53,7 @@ fn instance_without(left_out: &[&CStr]) -> Option<wgpu::Instance> {
         let mut extensions = hal_vk::Instance::desired_extensions(&entry, version, flags).ok()?;
         extensions.retain(|e| !left_out.contains(e));
         let names: Vec<*const c_char> = extensions.iter().map(|e| e.as_ptr()).collect();
-        let app = vk::ApplicationInfo::default()
-            .application_name(c"incise")
-            .engine_name(c"incise")
-            .api_version(version);
+        let app = application_info(version);
         let info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_extension_names(&names);
@@ -89,14 +83,25 @@ fn instance_without(left_out: &[&CStr]) -> Option<wgpu::Instance> {
 pub fn loader_version() -> Option<String> {
     // SAFETY: loading the system Vulkan loader; only its version is queried.
     let entry = unsafe { ash::Entry::load() }.ok()?;
-    // SAFETY: a plain query of the loaded entry.
-    let v = unsafe { entry.try_enumerate_instance_version() }
-        .ok()?
-        .unwrap_or(vk::API_VERSION_1_0);
+    let v = instance_version(&entry).ok()?;
     Some(format!(
         "{}.{}.{}",
         vk::api_version_major(v),
         vk::api_version_minor(v),
         vk::api_version_patch(v)
     ))
+}
+
+/// The instance version `entry`'s loader offers (1.0 for a loader older than the query).
+pub fn instance_version(entry: &ash::Entry) -> Result<u32, vk::Result> {
+    // SAFETY: a plain query of a loaded entry.
+    Ok(unsafe { entry.try_enumerate_instance_version() }?.unwrap_or(vk::API_VERSION_1_0))
+}
+
+/// incise's application info for a Vulkan instance of API `version`.
+pub fn application_info(version: u32) -> vk::ApplicationInfo<'static> {
+    vk::ApplicationInfo::default()
+        .application_name(c"incise")
+        .engine_name(c"incise")
+        .api_version(version)
 }

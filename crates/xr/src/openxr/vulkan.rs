@@ -17,6 +17,7 @@ use wgpu::hal::{self, vulkan as hal_vk};
 
 use super::error::{XrError, xr_call};
 use crate::device::RenderDevice;
+use crate::vulkan_instance::{application_info, instance_version};
 
 /// The Vulkan API version the app is written for, as wgpu-hal 30 asks it (1.3): with a
 /// lower one, wgpu-hal would still call the 1.2 core functions of a 1.3 device (timeline
@@ -235,20 +236,15 @@ pub fn create_gpu(creator: &impl VulkanCreator) -> Result<XrGpu, XrError> {
     unsafe {
         let entry = ash::Entry::load().map_err(|e| gpu_err("loading libvulkan")(e.to_string()))?;
         let flags = wgpu::InstanceFlags::empty();
-        let loader_version = entry
-            .try_enumerate_instance_version()
-            .map_err(|e| gpu_err("vkEnumerateInstanceVersion")(e.to_string()))?
-            .unwrap_or(vk::API_VERSION_1_0);
+        let loader_version = instance_version(&entry)
+            .map_err(|e| gpu_err("vkEnumerateInstanceVersion")(e.to_string()))?;
         if loader_version < vk::API_VERSION_1_1 {
             return Err(XrError::Gpu("the Vulkan loader is older than 1.1".into()));
         }
         let extensions = hal_vk::Instance::desired_extensions(&entry, loader_version, flags)
             .map_err(|e| gpu_err("Vulkan instance extensions")(e.to_string()))?;
         let ext_ptrs: Vec<*const c_char> = extensions.iter().map(|e| e.as_ptr()).collect();
-        let app = vk::ApplicationInfo::default()
-            .application_name(c"incise")
-            .engine_name(c"incise")
-            .api_version(VK_VERSION);
+        let app = application_info(VK_VERSION);
         let info = vk::InstanceCreateInfo::default()
             .application_info(&app)
             .enabled_extension_names(&ext_ptrs);
