@@ -11,6 +11,7 @@ use incise_sim::skin::Skin;
 use incise_sim::xpbd::FrameStats;
 use incise_sim::{Material, Solver};
 use incise_xr::RenderDevice;
+#[cfg(test)]
 use incise_xr::frame::pinned_nodes;
 
 use crate::pictures::screenshots::place_on;
@@ -37,7 +38,6 @@ pub struct XrBody {
     engaged: bool,
     tracked: bool,
     pose: ToolPose,
-    has_grabs: bool,
     nominal: u32,
     min_substeps: u32,
 }
@@ -81,7 +81,6 @@ impl XrBody {
             mut solver,
             skin,
             material,
-            grabbed_nodes,
             ..
         } = build_scene(&scene, path, None)?;
         scene.tool = own_tool;
@@ -104,7 +103,6 @@ impl XrBody {
                 engaged: false,
                 tracked: false,
                 pose,
-                has_grabs: grabbed_nodes > 0,
                 nominal,
                 min_substeps,
             },
@@ -127,14 +125,9 @@ impl XrBody {
         self.nominal
     }
 
-    /// The fewest stable substeps; the nominal count when the scene has scripted grabs
-    /// (a rebuilt solver would restart them).
+    /// The fewest stable substeps.
     pub fn min_substeps(&self) -> u32 {
-        if self.has_grabs {
-            self.nominal
-        } else {
-            self.min_substeps
-        }
+        self.min_substeps
     }
 
     /// The scene file.
@@ -214,8 +207,8 @@ impl XrBody {
         Ok(self.body.step_frame()?)
     }
 
-    /// Run `substeps` per frame from now on: the solver is rebuilt with the same state
-    /// (positions, velocities, released tets, pins, tool).
+    /// Run `substeps` per frame from now on: the solver continues with the same state
+    /// (positions, velocities, released tets, pins, grabs, tool: [`Solver::retuned`]).
     pub fn set_substeps(&mut self, substeps: u32) -> Result<()> {
         let old = self.body.solver();
         if substeps == old.params().substeps {
@@ -223,17 +216,9 @@ impl XrBody {
         }
         let mut params = old.params().clone();
         params.substeps = substeps;
-        let mut s = Solver::new(old.mesh().clone(), self.material, params)
+        let s = old
+            .retuned(self.material, params)
             .with_context(|| format!("{}: {substeps} substeps", self.path.display()))?;
-        s.set_positions(old.positions());
-        let released: Vec<u32> = (0..old.mesh().tet_count())
-            .filter(|&i| !old.cut().is_live(i))
-            .map(|i| i as u32)
-            .collect();
-        s.release(&released);
-        s.pin(&pinned_nodes(old));
-        s.set_velocities(old.velocities());
-        s.set_tool(self.contact(), self.pose)?;
         self.body = place_on(s, self.device, &self.dev)?;
         Ok(())
     }

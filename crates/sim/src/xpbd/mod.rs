@@ -14,6 +14,7 @@ mod params;
 mod release_schedule;
 mod rest_free;
 mod rest_free_lanes;
+mod retune;
 mod shared_nodes;
 mod solver;
 mod stability;
