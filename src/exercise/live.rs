@@ -17,22 +17,20 @@ use super::{
     read_history, reference_stroke, render_card, save_attempt, score_attempt,
 };
 use crate::pictures::plan_decal::PlanDecal;
+use crate::pictures::run_pictures::RunPictures;
 use crate::pictures::screenshots::{ImageSize, Screenshots};
-use crate::pictures::view_pictures::ViewPictures;
 use crate::sim_body::recorded::RecordedBody;
 use crate::sim_body::{Body, RestCut};
 
 /// Size of the before/after pictures in a live attempt's report, pixels.
 pub const ATTEMPT_PICTURE: ImageSize = ImageSize(960, 540);
 
-/// The offscreen pictures of a method body's live attempt: its tet view with the heat map
-/// of the method's quantity (an error kept as text: the attempt is then saved without).
-pub fn attempt_view_pictures() -> Result<ViewPictures, String> {
-    let heat_map = incise_xr::Overlays {
-        stress: true,
-        ..Default::default()
-    };
-    ViewPictures::new(ATTEMPT_PICTURE, heat_map).map_err(|e| format!("{e:#}"))
+/// The offscreen pictures of a live attempt on `body`: an XPBD body's own, with the
+/// exercise's plan `decal` drawn on it, else its tet view with the heat map of the
+/// method's quantity (an error kept as text: the attempt is then saved without).
+pub fn attempt_pictures(body: &RecordedBody, decal: &PlanDecal) -> Result<RunPictures, String> {
+    let decal = body.body.solver_parts().map(|_| decal);
+    RunPictures::for_body(&*body.body, ATTEMPT_PICTURE, decal).map_err(|e| format!("{e:#}"))
 }
 
 /// Where a live attempt's scalpel path is recorded on a body `B`: the preview's hand
@@ -85,9 +83,10 @@ impl AttemptBody for Body {
 }
 
 impl AttemptBody for RecordedBody {
-    type Pictures = ViewPictures;
+    type Pictures = RunPictures;
     fn scene_tets(&self) -> Option<usize> {
-        None
+        let parts = self.body.solver_parts()?;
+        Some(parts.body.solver().mesh().tet_count())
     }
     fn rest_cut(&self) -> Result<RestCut> {
         self.body.rest_cut().ok_or_else(|| {
@@ -100,8 +99,8 @@ impl AttemptBody for RecordedBody {
     fn device(&self) -> String {
         self.body.device()
     }
-    fn picture(&self, pictures: &mut ViewPictures) -> Result<RgbaImage> {
-        pictures.image(self.body.tet_view())
+    fn picture(&self, pictures: &mut RunPictures) -> Result<RgbaImage> {
+        pictures.image(&*self.body)
     }
     fn frame(&self) -> u64 {
         self.frames() as u64

@@ -2,6 +2,7 @@
 //! screenshots (of the XPBD solver, and of any method's tet views) and what the renderer
 //! is told of the scalpel.
 
+pub mod body_drawing;
 pub mod drawn_body;
 pub mod plan_decal;
 pub mod render_command;

@@ -60,6 +60,18 @@ impl RunPictures {
         })))
     }
 
+    /// A picture of `body` now.
+    pub fn image(&mut self, body: &dyn SimBody) -> Result<incise_xr::RgbaImage> {
+        match (self, body.solver_parts()) {
+            (RunPictures::Solver(s), Some(parts)) => s.image(parts.body),
+            (RunPictures::Views(v), _) => v.image(body.tet_view()),
+            (RunPictures::Solver(_), None) => bail!(
+                "XPBD screenshots cannot draw a {} body",
+                body.method().name()
+            ),
+        }
+    }
+
     /// Draw `body` now into the PNG `path`.
     pub fn save(&mut self, body: &dyn SimBody, path: &Path) -> Result<()> {
         match (self, body.solver_parts()) {

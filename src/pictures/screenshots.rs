@@ -76,15 +76,6 @@ pub fn default_camera(mesh: &TetMesh) -> Camera {
     cam
 }
 
-/// The stress at the top of the heat-map scale: the cut threshold, else the largest
-/// stress now (at least 1 Pa).
-pub fn stress_scale(solver: &Solver) -> f32 {
-    solver
-        .params()
-        .release_threshold
-        .unwrap_or_else(|| solver.von_mises().iter().copied().fold(1.0, f32::max))
-}
-
 /// Put `solver` on the chosen device; a GPU body is opened on `dev`, so the renderer can
 /// copy its node positions on the device. `auto` is decided by [`auto_device`] from
 /// `dev`'s adapter (a software one gets the CPU solver).
@@ -137,7 +128,7 @@ impl Screenshots {
             view,
             settings: RenderSettings {
                 overlays,
-                stress_max: stress_scale(solver),
+                stress_max: crate::sim_body::xpbd::stress_scale(solver),
                 ..RenderSettings::default()
             },
             pinned: pinned_nodes(solver),

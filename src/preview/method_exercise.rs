@@ -11,15 +11,15 @@ use glam::Vec3;
 use incise_sim::contact::ToolPose;
 use incise_xr::SurfaceLine;
 
-use crate::exercise::live::attempt_view_pictures;
+use crate::exercise::live::attempt_pictures;
 use crate::exercise::{Finished, LiveExercise, PoseRecording, ToolFrame};
-use crate::pictures::view_pictures::ViewPictures;
+use crate::pictures::run_pictures::RunPictures;
 use crate::sim_body::recorded::RecordedBody;
 
 /// An exercise open in the method window.
 pub struct MethodExercise {
     /// The exercise and its attempt under way.
-    pub live: LiveExercise<ViewPictures>,
+    pub live: LiveExercise<RunPictures>,
     /// The mouse blade's path during an attempt.
     stroke: PoseRecording,
 }
@@ -35,7 +35,7 @@ impl MethodExercise {
 
     /// Start an attempt on `body`, the exercise's scene as loaded.
     pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
-        let pictures = attempt_view_pictures();
+        let pictures = attempt_pictures(body, &self.live.decal);
         self.live.start(&mut self.stroke, body, pictures)
     }
 

@@ -26,7 +26,8 @@ use incise_xr::{BodyState, RenderSettings, Renderer};
 use winit::event::{ElementState, MouseScrollDelta};
 use winit::keyboard::ModifiersState;
 
-use crate::pictures::screenshots::{ImageSize, Screenshots, stress_scale};
+use crate::pictures::screenshots::{ImageSize, Screenshots};
+use crate::sim_body::xpbd::stress_scale;
 use crate::sim_body::{Body, DeviceChoice};
 
 use crate::exercise::live::ATTEMPT_PICTURE;

@@ -62,6 +62,7 @@ fn open_options(opts: &RunOptions) -> Result<OpenOptions> {
         stroke: opts.stroke.clone(),
         haptic_rate: opts.haptic_rate,
         quiet: opts.quiet,
+        hand: false,
         gpu: None,
         free_nodes,
     })

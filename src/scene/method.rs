@@ -16,6 +16,13 @@ pub enum Method {
 }
 
 impl Method {
+    /// Whether a headset session shows the heat map from the start: the method's own
+    /// quantity (tension, strain) is what a Nakao or rheology session is for; XPBD's
+    /// stress overlay is switched on by hand.
+    pub fn heat_map_first(self) -> bool {
+        self != Method::Xpbd
+    }
+
     /// The name written to report.json's `method`: "xpbd", "nakao" or "rheology".
     pub fn name(self) -> &'static str {
         match self {

@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use super::body_view::{BodyView, CutView, Quantity, Substeps, TetView};
 use super::outcome::Outcome;
 use super::rest_cut::RestCut;
 use super::xpbd_device::Body;
@@ -39,15 +40,6 @@ pub enum ToolInput {
     },
 }
 
-/// The name and unit of the per-vertex quantity a method colours its heat map with.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Quantity {
-    /// What it is, e.g. "von Mises stress", "spring tension", "edge strain".
-    pub name: &'static str,
-    /// Its unit, e.g. "Pa", "N", "1".
-    pub unit: &'static str,
-}
-
 /// The surface of a body as it is to be drawn.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Surface {
@@ -60,21 +52,6 @@ pub struct Surface {
     /// The heat-map quantity per vertex (in [`Surface::quantity`]'s unit).
     pub scalar: Vec<f32>,
     /// What [`Surface::scalar`] is.
-    pub quantity: Option<Quantity>,
-}
-
-/// The body as tets for the renderer (which draws a tet mesh's skin and colours the
-/// heat map per tet).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct TetView {
-    /// Node positions now, m.
-    pub positions: Vec<Vec3>,
-    /// The tets (node indices); they change when a method cuts by remodelling.
-    pub tets: Vec<[u32; 4]>,
-    /// The heat-map quantity per tet (mean over its nodes or the method's own per-tet
-    /// value).
-    pub per_tet: Vec<f32>,
-    /// What [`TetView::per_tet`] is.
     pub quantity: Option<Quantity>,
 }
 
@@ -119,10 +96,14 @@ pub struct OpenOptions {
     pub free_nodes: Option<Vec<usize>>,
     /// Print no notices.
     pub quiet: bool,
+    /// A hand holds the tool from the start (the headset's controller): an XPBD scene's
+    /// stroke is not played; its scalpel (the scene's, else the built-in one) waits above
+    /// the organ, dulled, until the hand takes it (XPBD).
+    pub hand: bool,
 }
 
 /// A simulated body of one method, stepped frame by frame.
-pub trait SimBody {
+pub trait SimBody: Send {
     /// Which method this body runs.
     fn method(&self) -> Method;
 
@@ -201,5 +182,33 @@ pub trait SimBody {
     /// skin, the scalpel); `None` for a body drawn from its [`SimBody::tet_view`].
     fn solver_parts(&self) -> Option<SolverParts<'_>> {
         None
+    }
+
+    /// The frame to draw, sharing with `previous` (a frame of this body drawn before)
+    /// what has not changed.
+    fn view(&self, _previous: Option<&CutView>) -> BodyView {
+        BodyView::Tets(self.tet_view())
+    }
+
+    /// The substeps of a body whose solver may run fewer to keep real time (`None`: the
+    /// method steps a frame its own way).
+    fn substeps(&self) -> Option<Substeps> {
+        None
+    }
+
+    /// Run `n` substeps a frame from now on, continuing the motion, cut and grabs; an
+    /// error for a body without [`SimBody::substeps`].
+    fn set_substeps(&mut self, n: u32) -> anyhow::Result<()> {
+        anyhow::bail!(
+            "a {} body has no substeps to set to {n}",
+            self.method().name()
+        )
+    }
+
+    /// Whether the body's own script moves its tool on [`ToolInput::Script`] (a Nakao
+    /// blade's stroke, a rheology indenter, an XPBD scene's stroke), so a hand takes the
+    /// tool over only when it engages; false: the tool waits for the hand.
+    fn script_holds_tool(&self) -> bool {
+        true
     }
 }

@@ -2,6 +2,7 @@
 //! on its device, the Nakao mass-spring cutter (frame by frame or at a haptic rate) and
 //! the three-element rheological body, side by side; [`open`] opens a scene's.
 
+pub mod body_view;
 pub mod edge_report;
 pub mod interface;
 pub mod nakao;
@@ -20,9 +21,8 @@ pub mod vertex_field;
 pub mod xpbd;
 pub mod xpbd_device;
 
-pub use interface::{
-    Fault, OpenOptions, Quantity, SimBody, SolverParts, StepError, Surface, TetView, ToolInput,
-};
+pub use body_view::{BodyView, CutShape, CutView, Quantity, Substeps, TetView};
+pub use interface::{Fault, OpenOptions, SimBody, SolverParts, StepError, Surface, ToolInput};
 pub use open::open;
 pub use outcome::Outcome;
 pub use rest_cut::{RestCut, RestCutFace};

@@ -21,7 +21,8 @@ use incise_sim::mass_spring::{
 use incise_sim::nakao_cut::measure::{counts, cut_surface_area, cut_triangles, opening_width};
 use incise_sim::nakao_cut::{BladePose, Cutter};
 
-use super::interface::{Fault, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
+use super::body_view::{Quantity, TetView};
+use super::interface::{Fault, SimBody, StepError, Surface, ToolInput};
 use super::nakao_blade::{Blade, stroke_hand, tool_point, touches};
 use super::nakao_outcome::model_outcome;
 use super::nakao_surface::{max_displacement, surface_triangles, tension_at_nodes};

@@ -14,7 +14,8 @@ use incise_sim::contact::ToolPose;
 use incise_sim::mass_spring::{HapticConfig, HapticLoop, LocalLoopParams, MassSpringModel};
 use incise_sim::nakao_cut::BladePose;
 
-use super::interface::{Fault, SimBody, StepError, Surface, TetView, ToolInput};
+use super::body_view::TetView;
+use super::interface::{Fault, SimBody, StepError, Surface, ToolInput};
 use super::nakao_blade::{Blade, tool_point};
 use super::outcome::Outcome;
 use crate::report::{EdgeFrameStats, FrameData, HapticInfo, Report};

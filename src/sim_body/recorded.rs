@@ -24,12 +24,17 @@ pub struct RecordedBody {
 impl RecordedBody {
     /// Open the scene at `path` (any method; the XPBD solver on the CPU).
     pub fn open(path: &Path) -> Result<RecordedBody> {
-        let scene = load_scene(path)?;
         let opts = OpenOptions {
             device: DeviceChoice::Cpu,
             ..OpenOptions::default()
         };
-        let (body, report) = open(&scene, path, &opts)?;
+        RecordedBody::open_with(path, &opts)
+    }
+
+    /// Open the scene at `path` (any method) as `opts` asks.
+    pub fn open_with(path: &Path, opts: &OpenOptions) -> Result<RecordedBody> {
+        let scene = load_scene(path)?;
+        let (body, report) = open(&scene, path, opts)?;
         let localisation = match &scene.model {
             ModelChoice::MassSpring(ms) => Some(ms.localisation.label()),
             _ => None,

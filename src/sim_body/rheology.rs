@@ -15,7 +15,8 @@ use incise_sim::contact::ToolPose;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::rheology::{FlatIndenter, PressSchedule, RheologyBody as Model, RheologyState};
 
-use super::interface::{Fault, Quantity, SimBody, StepError, Surface, TetView, ToolInput};
+use super::body_view::{Quantity, TetView};
+use super::interface::{Fault, SimBody, StepError, Surface, ToolInput};
 use super::outcome::{Outcome, StateHash};
 use crate::report::{EdgeFrameStats, FrameData, Report};
 use crate::scene::IndenterSpec;

@@ -3,22 +3,23 @@
 //! tets released where the von Mises stress passes the threshold.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use anyhow::{Result, bail};
-use glam::Vec3;
-use incise_sim::Solver;
+use glam::{Quat, Vec3};
 use incise_sim::contact::ToolPose;
+use incise_sim::gpu::GpuContext;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::skin::Skin;
 use incise_sim::xpbd::SolverError;
+use incise_sim::{Material, Solver};
 
-use super::interface::{
-    Fault, OpenOptions, Quantity, SimBody, SolverParts, StepError, Surface, TetView, ToolInput,
-};
+use super::body_view::{BodyView, CutShape, CutView, Quantity, Substeps, TetView};
+use super::interface::{Fault, OpenOptions, SimBody, SolverParts, StepError, Surface, ToolInput};
 use super::outcome::{Outcome, StateHash};
 use super::rest_cut::RestCut;
 use super::vertex_field::vertex_mean;
-use super::xpbd_device::Body;
+use super::xpbd_device::{Body, DeviceChoice};
 use crate::report::{FrameData, MaterialInfo, MeshInfo, Report, ToolInfo};
 use crate::scene::Method;
 use crate::scene::{BuiltScene, SceneTool, ToolDriver, build_scene_driven};
@@ -42,6 +43,32 @@ pub struct XpbdBody {
     /// Whether the tool is held without cutting (a hand's trigger up, a recorded stroke's
     /// lifted span): it pushes, dulled, as the headset's does.
     lifted: bool,
+    /// Whether the tool was moved by a hand or a stroke in the last frame; a hand that
+    /// takes a waiting tool puts it where it holds it at once (no sweep from where it
+    /// waited).
+    held: bool,
+    /// Whether a hand holds the tool from the start (the scene's stroke is not played).
+    hand: bool,
+    /// The mesh and skin every drawn frame shares.
+    shape: Arc<CutShape>,
+    /// The pinned nodes (drawn by the pinned-nodes overlay).
+    pinned: Arc<Vec<u32>>,
+    /// The material, the scene's substeps and the fewest stable ones (for a retune).
+    material: Material,
+    nominal: u32,
+    fewest: u32,
+    /// The GPU context the body was put on, to put a retuned solver on.
+    gpu: Option<GpuContext>,
+}
+
+/// Where a hand's tool waits until the hand takes it: 1 m above the organ.
+fn parked(solver: &Solver) -> ToolPose {
+    let (lo, hi) = solver.mesh().rest_bounds();
+    let c = (lo + hi) * 0.5;
+    ToolPose {
+        position: Vec3::new(c.x, c.y, hi.z + 1.0),
+        rotation: Quat::IDENTITY,
+    }
 }
 
 /// Open `scene` (from `path`) as an XPBD body with the run's report skeleton.
@@ -58,26 +85,50 @@ pub fn open(
     }
     // A recorded stroke is a hand's: the scene gets the tool the preview gave it
     // (scene/hand_tool.rs), so the replay is the same physics.
-    let driver = match opts.stroke {
-        Some(_) => ToolDriver::Hand,
-        None => ToolDriver::Scene,
+    let driver = match opts.stroke.is_some() || opts.hand {
+        true => ToolDriver::Hand,
+        false => ToolDriver::Scene,
     };
     let mut built = build_scene_driven(scene, path, opts.threads, driver)?;
-    if let (Some(t), Some(file)) = (built.tool.as_mut(), &opts.stroke) {
-        t.stroke = Some(incise_scalpel::load_stroke(file)?);
+    if let Some(t) = built.tool.as_mut() {
+        match &opts.stroke {
+            Some(file) => t.stroke = Some(incise_scalpel::load_stroke(file)?),
+            None if opts.hand => t.stroke = None,
+            None => {}
+        }
     }
-    // The tool this run drives: one with a stroke.
-    let tool = built.tool.take().filter(|t| t.stroke.is_some());
-    let pose = tool
-        .as_ref()
-        .and_then(|t| t.stroke.as_ref())
-        .map(|s| s.pose_at(0.0));
+    // The tool this run drives: one with a stroke, or a hand's.
+    let tool = built
+        .tool
+        .take()
+        .filter(|t| t.stroke.is_some() || opts.hand);
+    let pose = tool.as_ref().map(|t| match &t.stroke {
+        Some(s) => s.pose_at(0.0),
+        None => parked(&built.solver),
+    });
+    let waiting = tool.as_ref().is_some_and(|t| t.stroke.is_none());
     if let (Some(t), Some(p)) = (&tool, pose) {
-        built.solver.set_tool(t.contact.clone(), p)?;
+        let contact = match waiting {
+            true => t.contact.dulled(),
+            false => t.contact.clone(),
+        };
+        built.solver.set_tool(contact, p)?;
     }
     let mut report = skeleton(scene, path, &built, tool.as_ref());
     let mut choice = None;
-    let BuiltScene { solver, skin, .. } = built;
+    let BuiltScene {
+        solver,
+        skin,
+        material,
+        ..
+    } = built;
+    let shape = Arc::new(CutShape {
+        mesh: solver.mesh().clone(),
+        skin: skin.clone(),
+    });
+    let pinned = Arc::new(incise_xr::frame::pinned_nodes(&solver));
+    let nominal = solver.params().substeps;
+    let fewest = solver.fewest_stable_substeps().clamp(1, nominal);
     let body = Body::place_on(solver, opts.device, opts.gpu.as_ref(), |m| {
         choice = Some(m.to_string())
     })?;
@@ -96,7 +147,15 @@ pub fn open(
             skin,
             tool,
             pose,
-            lifted: false,
+            lifted: waiting,
+            held: !waiting,
+            hand: opts.hand,
+            shape,
+            pinned,
+            material,
+            nominal,
+            fewest,
+            gpu: opts.gpu.clone(),
         },
         report,
     ))
@@ -167,12 +226,14 @@ impl XpbdBody {
         }
     }
 
-    /// Put the scalpel at `pose` for the next frame, dulled while `lifted` (the tool is
-    /// set anew, as the headset's `XrBody::drive_tool` does, when that changes).
+    /// Put the scalpel at `pose` for the next frame, dulled while `lifted`: the tool is
+    /// set anew (no sweep) when that changes or when a hand takes a waiting tool; else it
+    /// moves there over the frame.
     fn place_tool(&mut self, pose: ToolPose, lifted: bool) -> Result<(), SolverError> {
         self.pose = Some(pose);
+        let taken = !std::mem::replace(&mut self.held, true);
         match &self.tool {
-            Some(t) if lifted != self.lifted => {
+            Some(t) if lifted != self.lifted || taken => {
                 self.lifted = lifted;
                 let contact = match lifted {
                     true => t.contact.dulled(),
@@ -202,9 +263,12 @@ impl SimBody for XpbdBody {
     }
 
     fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError> {
-        if let Some((pose, lifted)) = self.next_pose(tool) {
-            self.place_tool(pose, lifted)
-                .map_err(|e| StepError::Failed(e.to_string()))?;
+        match self.next_pose(tool) {
+            Some((pose, lifted)) => self
+                .place_tool(pose, lifted)
+                .map_err(|e| StepError::Failed(e.to_string()))?,
+            // The tool stays where it was; a hand that takes it again puts it at once.
+            None => self.held = false,
         }
         match self.body.step_frame() {
             Ok(stats) => Ok(FrameData::Xpbd(stats)),
@@ -285,19 +349,11 @@ impl SimBody for XpbdBody {
     }
 
     fn into_cpu(self: Box<Self>) -> Box<dyn SimBody> {
-        let XpbdBody {
-            body,
-            skin,
-            tool,
-            pose,
-            lifted,
-        } = *self;
+        let b = *self;
         Box::new(XpbdBody {
-            body: body.into_cpu(),
-            skin,
-            tool,
-            pose,
-            lifted,
+            body: b.body.into_cpu(),
+            gpu: None,
+            ..b
         })
     }
 
@@ -329,6 +385,53 @@ impl SimBody for XpbdBody {
         Ok(None)
     }
 
+    fn view(&self, previous: Option<&CutView>) -> BodyView {
+        let s = self.body.solver();
+        let released = s.cut().released_count();
+        // A frame of this body (the same shape) with as many tets released shares its cut.
+        let shared = match previous {
+            Some(p) if Arc::ptr_eq(&p.shape, &self.shape) => {
+                (p.cut.released_count() == released).then(|| p.cut.clone())
+            }
+            _ => None,
+        };
+        BodyView::Cut(CutView {
+            shape: self.shape.clone(),
+            positions: s.positions().to_vec(),
+            cut: shared.unwrap_or_else(|| Arc::new(s.cut().clone())),
+            von_mises: s.von_mises().to_vec(),
+            pinned: self.pinned.clone(),
+            stress_max: stress_scale(s),
+        })
+    }
+
+    fn substeps(&self) -> Option<Substeps> {
+        Some(Substeps {
+            now: self.body.solver().params().substeps,
+            nominal: self.nominal,
+            fewest: self.fewest,
+        })
+    }
+
+    fn set_substeps(&mut self, n: u32) -> Result<()> {
+        let old = self.body.solver();
+        if n == old.params().substeps {
+            return Ok(());
+        }
+        let mut params = old.params().clone();
+        params.substeps = n;
+        let s = old.retuned(self.material, params)?;
+        self.body = match &self.body {
+            Body::Cpu(_) => Body::Cpu(Box::new(s)),
+            Body::Gpu(_) => Body::place_on(s, DeviceChoice::Gpu, self.gpu.as_ref(), |_| {})?,
+        };
+        Ok(())
+    }
+
+    fn script_holds_tool(&self) -> bool {
+        !self.hand
+    }
+
     fn solver_parts(&self) -> Option<SolverParts<'_>> {
         Some(SolverParts {
             body: &self.body,
@@ -336,6 +439,15 @@ impl SimBody for XpbdBody {
             tool: self.tool.as_ref().map(|t| &t.tool),
         })
     }
+}
+
+/// Full scale of `solver`'s stress heat map: its release threshold, else the largest
+/// stress now (at least 1 Pa).
+pub fn stress_scale(solver: &Solver) -> f32 {
+    solver
+        .params()
+        .release_threshold
+        .unwrap_or_else(|| solver.von_mises().iter().copied().fold(1.0, f32::max))
 }
 
 /// The tets `solver` has released, in index order.
@@ -363,4 +475,89 @@ pub fn write_solver_vtu(solver: &Solver, path: &Path) -> Result<()> {
         point_scalars: vec![],
     };
     Ok(write_vtu(path, &frame)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `config/plate_cut.ron` opened for a hand (the headset's controller).
+    fn hand_plate() -> XpbdBody {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut.ron");
+        let scene = crate::scene::load_scene(&path).unwrap();
+        let opts = OpenOptions {
+            device: DeviceChoice::Cpu,
+            hand: true,
+            quiet: true,
+            ..OpenOptions::default()
+        };
+        open(&scene, &path, &opts).unwrap().0
+    }
+
+    #[test]
+    fn a_hands_scalpel_waits_then_goes_where_the_hand_holds_it() {
+        let mut b = hand_plate();
+        assert!(!b.script_holds_tool(), "the scene's stroke is not played");
+        let parked = b.tool_pose().unwrap();
+        let (_, hi) = b.body.solver().mesh().rest_bounds();
+        assert!(parked.position.z > hi.z + 0.5, "{parked:?}");
+        // The script moves nothing: the blade waits.
+        b.step(&ToolInput::Script).unwrap();
+        assert_eq!(b.body.solver().tool().unwrap().to, parked);
+        // The hand takes it on the plate, trigger up: it is put there at once (its motion
+        // over the next frame starts there), not swept down from where it waited.
+        let at = |x: f32| ToolPose {
+            position: Vec3::new(x, 0.02, 0.021),
+            rotation: Quat::IDENTITY,
+        };
+        let motion = |b: &XpbdBody| {
+            let m = b.body.solver().tool().unwrap();
+            (m.from, m.to)
+        };
+        b.place_tool(at(0.04), true).unwrap();
+        assert_eq!(motion(&b), (at(0.04), at(0.04)));
+        // Held, it moves over the frame.
+        b.place_tool(at(0.045), true).unwrap();
+        assert_eq!(motion(&b), (at(0.04), at(0.045)));
+        // Let go (untracked: the script's turn, which moves nothing) and taken again
+        // elsewhere: put there at once again.
+        b.step(&ToolInput::Script).unwrap();
+        b.place_tool(at(0.02), true).unwrap();
+        assert_eq!(motion(&b), (at(0.02), at(0.02)));
+    }
+
+    #[test]
+    fn fewer_substeps_keep_the_state_and_the_tool() {
+        let mut b = hand_plate();
+        let s = b.substeps().unwrap();
+        assert!(s.fewest >= 1 && s.fewest < s.nominal, "{s:?}");
+        let pose = ToolPose {
+            position: Vec3::new(0.04, 0.02, 0.021),
+            rotation: Quat::IDENTITY,
+        };
+        for _ in 0..3 {
+            b.step(&ToolInput::Hand {
+                pose,
+                engaged: true,
+            })
+            .unwrap();
+        }
+        let Body::Cpu(solver) = &mut b.body else {
+            panic!("--device cpu gave a GPU body")
+        };
+        solver.release(&[100, 2000, 5000]);
+        let before = b.body.solver().positions().to_vec();
+        let moving = b.body.solver().velocities().to_vec();
+        let released = released_tets(b.body.solver());
+        let time = b.time();
+        b.set_substeps(s.fewest).unwrap();
+        assert_eq!(b.substeps().unwrap().now, s.fewest);
+        let after = b.body.solver();
+        assert_eq!(after.positions(), &before[..]);
+        assert_eq!(after.velocities(), &moving[..]);
+        assert_eq!(released_tets(after), released, "the cut kept");
+        assert_eq!(b.time(), time, "the clock goes on");
+        assert_eq!(after.tool().unwrap().to, pose, "the scalpel stays attached");
+        assert!(b.set_substeps(s.nominal).is_ok());
+    }
 }

@@ -10,18 +10,15 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use glam::{Mat4, Vec3};
 use incise_sim::contact::ToolPose;
-use incise_sim::skin::Skin;
 use incise_xr::openxr::result_panel::panel_transform;
 use incise_xr::openxr::tray::Tray;
-use incise_xr::{RenderDevice, Renderer, RgbaImage, SurfaceLine};
+use incise_xr::{RenderDevice, Renderer, RgbaImage};
 use serde::Serialize;
 
-use super::xr_body::XrBody;
-use crate::exercise::live::{ATTEMPT_PICTURE, attempt_view_pictures};
-use crate::exercise::{AttemptBody, LiveExercise, LoadedExercise, PoseRecording, ToolFrame};
+use crate::exercise::live::attempt_pictures;
+use crate::exercise::{LiveExercise, LoadedExercise, PoseRecording, ToolFrame};
 use crate::pictures::plan_decal::PlanDecal;
-use crate::pictures::screenshots::Screenshots;
-use crate::sim_body::Body;
+use crate::pictures::run_pictures::RunPictures;
 use crate::sim_body::recorded::RecordedBody;
 
 /// What became of one attempt in the session (in `xr_report.json`).
@@ -37,10 +34,10 @@ pub struct AttemptSummary {
     pub ended_by: String,
 }
 
-/// The exercise state of an XR session on a body `B`: an XPBD [`Body`], or a Nakao
-/// scene's [`RecordedBody`] (scored on its cut surface).
-pub struct XrExercise<B: AttemptBody = Body> {
-    live: LiveExercise<B::Pictures>,
+/// The exercise state of an XR session on a body of any method (an XPBD body scored on
+/// its released tets, a Nakao body on its cut surface).
+pub struct XrExercise {
+    live: LiveExercise<RunPictures>,
     /// The right controller's path during an attempt, timed by simulated frames since
     /// the attempt's start (so `incise exercise --stroke` replays it on the scene as
     /// loaded).
@@ -55,10 +52,10 @@ pub struct XrExercise<B: AttemptBody = Body> {
     pub attempts: Vec<AttemptSummary>,
 }
 
-impl<B: AttemptBody> XrExercise<B> {
+impl XrExercise {
     /// Open the exercise at `path`; attempts are saved under `out_root` and appended to
     /// `history`.
-    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<XrExercise<B>> {
+    pub fn open(path: &Path, out_root: &Path, history: &Path) -> Result<XrExercise> {
         Ok(XrExercise {
             live: LiveExercise::open(path)?,
             stroke: PoseRecording::default(),
@@ -101,18 +98,18 @@ impl<B: AttemptBody> XrExercise<B> {
     /// A pressed. With an attempt in which the blade touched the tissue: finish it (the
     /// card is shown; returns false: keep the scene). Otherwise: returns true, the caller
     /// resets the scene and calls [`XrExercise::start`].
-    pub fn on_a(&mut self, xr: &B) -> Result<bool> {
+    pub fn on_a(&mut self, xr: &RecordedBody) -> Result<bool> {
         if self.live.touched() {
             self.finish(xr, "A pressed")?;
             Ok(false)
         } else {
-            self.live.abort::<B>(&mut self.stroke);
+            self.live.abort::<RecordedBody>(&mut self.stroke);
             Ok(true)
         }
     }
 
     /// The session is over: finish an attempt in which the blade touched the tissue.
-    pub fn end_session(&mut self, xr: &B) -> Result<()> {
+    pub fn end_session(&mut self, xr: &RecordedBody) -> Result<()> {
         if self.live.touched() {
             self.finish(xr, "session ended")?;
         }
@@ -122,20 +119,20 @@ impl<B: AttemptBody> XrExercise<B> {
     /// The solver failed (`why`; its last frame rolled back) and the scene is about to
     /// be reset: an attempt the blade touched is scored and saved as it stood, others are
     /// dropped.
-    pub fn on_solver_failure(&mut self, xr: &B, why: &str) -> Result<()> {
+    pub fn on_solver_failure(&mut self, xr: &RecordedBody, why: &str) -> Result<()> {
         if self.live.touched() {
             self.finish(xr, &format!("solver failed: {why}"))
         } else {
-            self.live.abort::<B>(&mut self.stroke);
+            self.live.abort::<RecordedBody>(&mut self.stroke);
             Ok(())
         }
     }
 
-    fn finish(&mut self, xr: &B, why: &str) -> Result<()> {
+    fn finish(&mut self, xr: &RecordedBody, why: &str) -> Result<()> {
         if self.stroke.is_empty() {
             // The blade touched with no tracked pose recorded (cannot happen while the
             // tool follows the controller); nothing to replay: drop it.
-            self.live.abort::<B>(&mut self.stroke);
+            self.live.abort::<RecordedBody>(&mut self.stroke);
             bail!("the attempt has no recorded scalpel poses");
         }
         let done = self
@@ -188,44 +185,12 @@ impl<B: AttemptBody> XrExercise<B> {
     }
 }
 
-impl XrExercise<Body> {
-    /// Start an attempt on `xr`, which is at its scene as loaded; pictures of the report
-    /// are rendered on `dev`.
-    pub fn start(&mut self, xr: &mut XrBody, skin: &Skin, dev: &RenderDevice) -> Result<()> {
-        self.card_changed |= self.card.take().is_some();
-        let pictures = Screenshots::new(
-            Some(dev),
-            xr.solver(),
-            skin,
-            ATTEMPT_PICTURE,
-            Default::default(),
-        )
-        .map(|s| {
-            let s = s
-                .with_tool(xr.scalpel())
-                .with_decal(self.live.decal.clone());
-            match xr.body {
-                Body::Gpu(_) => s.with_shared_device(),
-                Body::Cpu(_) => s,
-            }
-        })
-        .map_err(|e| format!("{e:#}"));
-        self.live.start(&mut self.stroke, &mut xr.body, pictures)
-    }
-
-    /// The plan on the tissue as it is now (where not cut away).
-    pub fn lines(&self, xr: &XrBody) -> Vec<SurfaceLine> {
-        let s = xr.solver();
-        vec![self.live.decal.line_uncut(s.positions(), s.cut().live())]
-    }
-}
-
-impl XrExercise<RecordedBody> {
-    /// Start an attempt on `body`, a Nakao scene as loaded; pictures of the report are
-    /// taken of its tet view offscreen.
+impl XrExercise {
+    /// Start an attempt on `body`, the exercise's scene as loaded; pictures of the report
+    /// are taken offscreen.
     pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
         self.card_changed |= self.card.take().is_some();
-        let pictures = attempt_view_pictures();
+        let pictures = attempt_pictures(body, &self.live.decal);
         self.live.start(&mut self.stroke, body, pictures)
     }
 }

@@ -19,9 +19,9 @@ use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, XrError};
 use incise_xr::{Overlays, RenderDevice, RenderSettings};
 
+use super::command::{Advanced, ToolCommand};
 use super::frame_log::{FrameLog, FrameRow};
 use super::headset_sim::{HeadsetSim, Picture};
-use super::sim_state::{Advanced, ToolCommand};
 
 /// `Idle` answers in a row after which the loop gives up (about 10 s of a runtime that
 /// never makes the session ready).

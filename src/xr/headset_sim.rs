@@ -1,7 +1,7 @@
 //! The simulation of a headset session as the one display loop ([`super::frame_loop`])
 //! drives it, whatever the method: hand it each display frame's tool command, press A,
-//! and take the picture to draw both eyes from. XPBD's body ([`super::xpbd_session`]) and
-//! any other method's ([`super::method_session`]) implement it.
+//! and take the picture to draw both eyes from. The session of a body of any method
+//! ([`super::session`]) implements it.
 
 use anyhow::Result;
 use glam::Mat4;
@@ -10,7 +10,7 @@ use incise_xr::openxr::HeadsetFrame;
 use incise_xr::openxr::tray::Tray;
 use incise_xr::{BodyState, Renderer, SurfaceLine};
 
-use super::sim_state::{Advanced, CommandStamp, ToolCommand};
+use super::command::{Advanced, CommandStamp, ToolCommand};
 
 /// What a display frame draws: the body with the renderer built for it, and what goes
 /// with it.

@@ -1,160 +1,198 @@
-//! The simulation thread: it owns the body for the session, steps fixed-dt frames paced
-//! to real time by the frame pacer (substeps cut first, then simulated time given up when
-//! a frame costs more than its dt), each with the display's newest tool command, and
-//! publishes every completed frame for the display to render. The display never waits
-//! for it; when it is slower than real time it falls behind, the display does not.
-//! Its errors and panics end the session with the error, the stroke still saved.
+//! The simulation thread of a headset session, for a body of any method: it owns the
+//! body ([`LiveSim`]) for the session, steps fixed-dt frames paced to real time by the
+//! frame pacer (substeps cut first where the body has them, then simulated time given up
+//! when a frame costs more than its dt), each with the display's newest command, and
+//! publishes every completed frame for the display to draw. The display never waits for
+//! it; when it is slower than real time it falls behind, the display does not. Its
+//! errors and panics end the session with the error; the body comes back to the session
+//! however it ended (its recorded stroke and report are still saved).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use anyhow::{Result, anyhow};
-use incise_scalpel::Stroke;
-use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
+use incise_sim::contact::ToolPose;
+use incise_xr::openxr::pacing::FramePacer;
 
+use super::command::{BodyCommand, CommandStamp};
 use super::latest::Latest;
-use super::sim_state::{SimState, ToolCommand};
-use super::sim_step::{SimStepper, Stepped};
-use super::xr_body::XrBody;
+use super::live_sim::{LiveSim, Stepped};
+use crate::sim_body::BodyView;
 
 /// Fraction of a simulation frame's dt its step may take on the thread before substeps
 /// are cut (the rest is headroom to catch up).
 pub const THREAD_BUDGET: f64 = 0.9;
-/// Most simulation frames stepped at once after the thread fell behind; the rest of the
-/// owed time is given up.
+/// Most simulation frames stepped at once after the thread fell behind (or in one display
+/// frame); the rest of the owed time is given up.
 pub const MAX_CATCH_UP: u32 = 3;
 
-/// What the display and the simulation thread share.
+/// A completed simulation frame, as the display draws it.
+pub struct Published {
+    /// The body.
+    pub view: BodyView,
+    /// Magnitude of the tissue's force on the tool, N.
+    pub force: f32,
+    /// Where the body draws its scalpel.
+    pub scalpel: Option<ToolPose>,
+    /// Simulation frames stepped in the session so far.
+    pub frames: u64,
+    /// Substeps the frame ran.
+    pub substeps: u32,
+    /// Wall time of the frame's step, ms (0 before the first).
+    pub step_ms: f64,
+    /// The newest command the frame was stepped with (`None`: not stepped yet).
+    pub command: Option<CommandStamp>,
+    /// A played stroke has been played to its end.
+    pub stroke_done: bool,
+}
+
+impl Published {
+    /// The state of `live` now, sharing its cut with `previous` where unchanged.
+    fn of(live: &LiveSim, previous: Option<&Published>) -> Published {
+        let shared = previous.and_then(|p| match &p.view {
+            BodyView::Cut(c) => Some(c),
+            BodyView::Tets(_) => None,
+        });
+        Published {
+            view: live.view(shared),
+            force: live.force,
+            scalpel: live.body.body.scalpel_pose(),
+            frames: live.frames,
+            substeps: live.substeps(),
+            step_ms: live.last_ms,
+            command: live.last_command,
+            stroke_done: live.stroke_done(),
+        }
+    }
+}
+
+/// What the display and the thread share.
 #[derive(Default)]
-pub struct SimLink {
-    /// The display's newest command.
-    pub commands: Latest<ToolCommand>,
-    /// The newest completed simulation frame.
-    pub states: Latest<SimState>,
+struct Link {
+    commands: Latest<BodyCommand>,
+    states: Latest<Published>,
     stop: AtomicBool,
     failure: Mutex<Option<anyhow::Error>>,
 }
 
-impl SimLink {
-    /// Ask the thread to stop (it finishes the frame it is stepping).
-    pub fn stop(&self) {
-        self.stop.store(true, Ordering::Release);
-    }
-
+impl Link {
     fn stopped(&self) -> bool {
         self.stop.load(Ordering::Acquire)
     }
 
-    /// The error that stopped the thread, once (then `None`).
-    pub fn take_failure(&self) -> Option<anyhow::Error> {
+    fn fail(&self, e: anyhow::Error) {
+        *self.failure.lock().unwrap_or_else(PoisonError::into_inner) = Some(e);
+    }
+
+    fn take_failure(&self) -> Option<anyhow::Error> {
         self.failure
             .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .unwrap_or_else(PoisonError::into_inner)
             .take()
     }
-
-    fn fail(&self, e: anyhow::Error) {
-        *self
-            .failure
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(e);
-    }
-}
-
-/// How the thread runs.
-pub struct ThreadConfig {
-    /// Keep the scene's substeps whatever the cost (a played stroke).
-    pub nominal_pacing: bool,
 }
 
 /// What the thread did, returned when it ends.
-pub struct ThreadOutcome {
-    /// Frames stepped.
-    pub frames: u64,
+pub struct ThreadEnd {
+    /// The body, as the thread left it.
+    pub live: LiveSim,
     /// Simulated time given up, s.
     pub dropped_time: f64,
-    /// Fewest substeps used.
-    pub min_substeps_used: u32,
-    /// Times the solver failed and the scene was reset.
-    pub solver_resets: u32,
-    /// Largest contact force, N.
-    pub max_force: f32,
-    /// The scalpel's recorded path.
-    pub stroke: Option<Stroke>,
     /// Wall time from the first command to the end, s.
     pub wall_s: f64,
+    /// The failure that stopped the thread, if the display has not taken it.
+    pub error: Option<anyhow::Error>,
 }
 
-/// The thread's state.
-struct SimLoop<'s, 'x> {
-    xr: &'x mut XrBody,
-    link: &'s SimLink,
-    stepper: SimStepper<'s>,
-    pacer: FramePacer,
-    resets_seen: u64,
-    min_substeps: u32,
-    sim_dt: f64,
-    started: Option<Instant>,
+/// The running thread.
+pub struct SimThread {
+    link: Arc<Link>,
+    handle: Option<JoinHandle<ThreadEnd>>,
 }
 
-/// Run the simulation of `xr` until `link` says stop; `stepper` steps the frames.
-pub fn run(
-    xr: &mut XrBody,
-    link: &SimLink,
-    stepper: SimStepper<'_>,
-    cfg: ThreadConfig,
-) -> ThreadOutcome {
-    let nominal = xr.nominal_substeps();
-    let sim_dt = xr.solver().params().frame_dt as f64;
-    let min = if cfg.nominal_pacing {
-        nominal
-    } else {
-        xr.min_substeps()
-    };
-    let pacer = FramePacer::new(PacingConfig {
-        sim_dt,
-        nominal_substeps: nominal,
-        min_substeps: min,
-        budget_fraction: THREAD_BUDGET,
-        max_sim_frames: MAX_CATCH_UP,
-    });
-    let mut sim = SimLoop {
-        xr,
+impl SimThread {
+    /// Step `live` on a new thread, paced to real time (the scene's substeps kept when
+    /// `nominal`); its first state is published at once.
+    pub fn spawn(live: LiveSim, nominal: bool) -> Result<SimThread> {
+        let link = Arc::new(Link::default());
+        link.states.put(Published::of(&live, None));
+        let l = Arc::clone(&link);
+        let handle = std::thread::Builder::new()
+            .name("incise-sim".into())
+            .spawn(move || run(live, nominal, &l))?;
+        Ok(SimThread {
+            link,
+            handle: Some(handle),
+        })
+    }
+
+    /// Ask for `cmd` (the newest command replaces any not yet taken).
+    pub fn post(&self, cmd: BodyCommand) {
+        self.link.commands.put(cmd);
+    }
+
+    /// The newest completed frame; the thread's error once it has stopped on one.
+    pub fn latest(&self) -> Result<Arc<Published>> {
+        if let Some(e) = self.link.take_failure() {
+            return Err(e);
+        }
+        self.link
+            .states
+            .get()
+            .ok_or_else(|| anyhow!("the simulation thread published no frame"))
+    }
+
+    /// Stop the thread (it finishes the frame it is stepping) and take the body back.
+    pub fn finish(mut self) -> Result<ThreadEnd> {
+        self.link.stop.store(true, Ordering::Release);
+        let h = self
+            .handle
+            .take()
+            .ok_or_else(|| anyhow!("the simulation thread has already ended"))?;
+        let mut end = h
+            .join()
+            .map_err(|_| anyhow!("the simulation thread panicked while saving its outcome"))?;
+        end.error = end.error.or_else(|| self.link.take_failure());
+        Ok(end)
+    }
+}
+
+impl Drop for SimThread {
+    /// A session that ends on an error still stops the thread.
+    fn drop(&mut self) {
+        self.link.stop.store(true, Ordering::Release);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// The thread: step until stopped; a panic is caught so the body comes back.
+fn run(mut live: LiveSim, nominal: bool, link: &Link) -> ThreadEnd {
+    let pacer = live.pacer(THREAD_BUDGET, MAX_CATCH_UP, nominal);
+    let mut sim = Loop {
         link,
-        stepper,
         pacer,
         resets_seen: 0,
-        min_substeps: nominal,
-        sim_dt,
         started: None,
     };
-    // A panic is caught here so the path recorded so far survives it.
-    let ended = catch_unwind(AssertUnwindSafe(|| sim.run())).unwrap_or_else(|p| {
+    let ended = catch_unwind(AssertUnwindSafe(|| sim.run(&mut live))).unwrap_or_else(|p| {
         Err(anyhow!(
             "the simulation thread panicked: {}",
             panic_text(p.as_ref())
         ))
     });
-    let stroke = match sim.stepper.recorded() {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("xr: the recorded stroke: {e:#}");
-            None
-        }
-    };
     if let Err(e) = ended {
         link.fail(e);
     }
-    ThreadOutcome {
-        frames: sim.stepper.frames,
+    ThreadEnd {
         dropped_time: sim.pacer.dropped_time(),
-        min_substeps_used: sim.min_substeps,
-        solver_resets: sim.stepper.failures,
-        max_force: sim.stepper.max_force,
-        stroke,
         wall_s: sim.started.map_or(0.0, |t| t.elapsed().as_secs_f64()),
+        live,
+        error: None,
     }
 }
 
@@ -166,9 +204,16 @@ fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "(no message)".into())
 }
 
-impl SimLoop<'_, '_> {
-    fn run(&mut self) -> Result<()> {
-        self.stepper.start(self.xr)?;
+/// The thread's pacing state.
+struct Loop<'l> {
+    link: &'l Link,
+    pacer: FramePacer,
+    resets_seen: u64,
+    started: Option<Instant>,
+}
+
+impl Loop<'_> {
+    fn run(&mut self, live: &mut LiveSim) -> Result<()> {
         // The clock starts with the display's first command.
         while self.link.commands.get().is_none() {
             if self.link.stopped() {
@@ -178,30 +223,32 @@ impl SimLoop<'_, '_> {
         }
         let clock = Instant::now();
         self.started = Some(clock);
-        self.publish(true, 0.0);
+        let dt = live.dt();
         while !self.link.stopped() {
             let cmd = self.command();
-            let rebuilt = self.apply_reset(&cmd)?;
-            let mut plan = self.pacer.plan(clock.elapsed().as_secs_f64(), self.sim_dt);
-            if cmd.paused || self.stepper.stroke_done() {
+            if cmd.resets > self.resets_seen {
+                self.resets_seen = cmd.resets;
+                live.reset()?;
+                self.publish(live, true);
+            }
+            let mut plan = self.pacer.plan(clock.elapsed().as_secs_f64(), dt);
+            if cmd.paused || live.stroke_done() {
                 plan.sim_frames = 0;
             }
             if plan.sim_frames == 0 {
-                if rebuilt {
-                    self.publish(true, 0.0);
-                }
-                self.sleep_until_owed();
+                let wait = self.pacer.until_next_frame().clamp(0.0005, dt);
+                std::thread::sleep(Duration::from_secs_f64(wait));
                 continue;
             }
             let started = Instant::now();
-            self.step_frames(plan.sim_frames, plan.substeps, rebuilt)?;
+            live.set_substeps(plan.substeps)?;
+            self.step_frames(live, plan.sim_frames)?;
             self.pacer.record(plan, started.elapsed().as_secs_f64());
-            self.min_substeps = self.min_substeps.min(plan.substeps);
         }
         Ok(())
     }
 
-    fn command(&self) -> ToolCommand {
+    fn command(&self) -> BodyCommand {
         *self
             .link
             .commands
@@ -209,59 +256,33 @@ impl SimLoop<'_, '_> {
             .expect("the loop starts after the first command")
     }
 
-    /// A reset the display asked for since the last frame: the scene back to rest.
-    fn apply_reset(&mut self, cmd: &ToolCommand) -> Result<bool> {
-        if cmd.resets <= self.resets_seen {
-            return Ok(false);
-        }
-        self.resets_seen = cmd.resets;
-        self.xr.reset()?;
-        Ok(true)
-    }
-
-    /// `frames` frames at `substeps`, each with the newest command, each published
-    /// (`rebuilt`: the scene was rebuilt since the last one published).
-    fn step_frames(&mut self, frames: u32, substeps: u32, mut rebuilt: bool) -> Result<()> {
-        if substeps != self.xr.solver().params().substeps {
-            self.xr.set_substeps(substeps)?;
-            rebuilt = true;
-        }
+    /// `frames` frames, each with the newest command, each published; a failed one
+    /// starts the scene over.
+    fn step_frames(&mut self, live: &mut LiveSim, frames: u32) -> Result<()> {
         for _ in 0..frames {
             let cmd = self.command();
-            match self.stepper.step(self.xr, &cmd)? {
-                Stepped::Done { stats, .. } => {
-                    self.publish(rebuilt, stats.tool_force.length());
-                    rebuilt = false;
-                }
+            match live.step(&cmd)? {
+                Stepped::Done => self.publish(live, false),
                 Stepped::Failed(e) => {
                     // Rolled back: start the scene again rather than end the session.
-                    eprintln!("xr: {e:#}; resetting the scene");
-                    self.xr.reset()?;
-                    self.publish(true, 0.0);
+                    eprintln!("xr: {e}; resetting the scene");
+                    live.reset()?;
+                    self.publish(live, true);
                     break;
                 }
             }
-            if self.stepper.stroke_done() {
+            if live.stroke_done() {
                 break;
             }
         }
         Ok(())
     }
 
-    fn publish(&self, rebuilt: bool, tool_force: f32) {
-        let previous = self.link.states.get();
-        let mut s = SimState::capture(self.xr, previous.as_deref(), rebuilt);
-        s.frame = self.stepper.frames;
-        s.sim_time = self.stepper.sim_time;
-        s.tool_force = tool_force;
-        s.step_ms = self.stepper.last_ms;
-        s.command = self.stepper.last_command;
-        s.stroke_done = self.stepper.stroke_done();
-        self.link.states.put(s);
-    }
-
-    fn sleep_until_owed(&self) {
-        let wait = self.pacer.until_next_frame().clamp(0.0005, self.sim_dt);
-        std::thread::sleep(Duration::from_secs_f64(wait));
+    /// Publish `live`'s frame (`fresh`: a new body, nothing shared with the last).
+    fn publish(&self, live: &LiveSim, fresh: bool) {
+        let previous = (!fresh).then(|| self.link.states.get()).flatten();
+        self.link
+            .states
+            .put(Published::of(live, previous.as_deref()));
     }
 }

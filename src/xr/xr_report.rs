@@ -10,8 +10,34 @@ use serde::Serialize;
 
 use super::exercise::AttemptSummary;
 use super::frame_log::FrameLog;
-use super::xr_body::CutBox;
 use crate::scene::Method;
+
+/// A bounding box: its min and max corners (sim world, m).
+pub type CutBox = ([f32; 3], [f32; 3]);
+
+/// The tets `solver` has released, and the bounding box of their rest centroids: how
+/// much was cut and where.
+pub fn cut_extent(solver: &incise_sim::Solver) -> (usize, Option<CutBox>) {
+    let mesh = solver.mesh();
+    let centroids: Vec<glam::Vec3> = (0..mesh.tet_count())
+        .filter(|&i| !solver.cut().is_live(i))
+        .map(|i| {
+            mesh.tets[i]
+                .iter()
+                .map(|&n| mesh.rest_positions[n as usize])
+                .sum::<glam::Vec3>()
+                * 0.25
+        })
+        .collect();
+    let bounds = centroids
+        .iter()
+        .fold(None, |b: Option<(glam::Vec3, glam::Vec3)>, &c| {
+            let (lo, hi) = b.unwrap_or((c, c));
+            Some((lo.min(c), hi.max(c)))
+        })
+        .map(|(lo, hi)| (lo.to_array(), hi.to_array()));
+    (centroids.len(), bounds)
+}
 
 /// The session summary written as `xr_report.json`.
 #[derive(Debug, Default, Serialize)]
