@@ -6,6 +6,12 @@
 # is one rule (crates/test-gate): INCISE_REQUIRE_GPU, INCISE_REQUIRE_XR and
 # INCISE_REQUIRE_BROWSER take 1 (fail), 0 (skip) or unset (skip, but fail when CI is set);
 # any other value is an error.
+#
+# `scripts/test.sh --slow [CARGO TEST TARGETS]` is CI's second step instead (.ci/run runs it
+# after the whole suite): every test marked #[ignore], in every crate, because it takes a
+# minute or so (the full experiments against docs/experiments/, the large-scene docs
+# figures), about 3 minutes in all on 2 cores once the suite has built them. It needs no
+# GPU, browser or XR runtime, so it builds no Monado.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,6 +33,15 @@ required() {
 for var in INCISE_REQUIRE_GPU INCISE_REQUIRE_XR INCISE_REQUIRE_BROWSER; do
     required "$var" || true
 done
+
+if [ "${1:-}" = "--slow" ]; then
+    shift
+    source scripts/ensure-deps.sh
+    # All test harnesses (--tests: not the doctests, which the suite has run), or the
+    # targets named (`--slow --test experiments_cli`).
+    [ $# -gt 0 ] || set -- --tests
+    exec cargo test --workspace --release --locked "$@" -- --ignored
+fi
 
 INCISE_TEST_DEPS=1 source scripts/ensure-deps.sh
 if manifest="$(bash scripts/monado.sh)"; then

@@ -33,9 +33,10 @@ pub struct SceneFigure {
     pub peak_force: f64,
 }
 
-/// Scenes with more tets than this take minutes to run to their end on 2 cores (the
-/// intestine: 125 substeps a frame); tests/docs_figures.rs checks their frames and tets
-/// from the scene ([`shape`]) and leaves the full rerun to an ignored test.
+/// Scenes with more tets than this are too slow for the normal test suite (the intestine:
+/// 125 substeps a frame, about 30 s on 2 cores); tests/docs_figures.rs checks their frames
+/// and tets from the scene ([`shape`]) and leaves the full rerun to an ignored test that
+/// CI's slow step runs (`scripts/test.sh --slow`).
 pub const LARGE_TETS: usize = 30_000;
 
 /// Frames the scene runs (its duration at its frame rate) and the tets of its mesh,

@@ -1,4 +1,4 @@
-//! Scenes shared by the VBD tests and the VBD measurement table.
+//! Scenes shared by the VBD tests and the VBD measurement table (examples/vbd_measure.rs).
 #![allow(dead_code)]
 
 use glam::{UVec3, Vec3};
