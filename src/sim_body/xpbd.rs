@@ -406,6 +406,10 @@ impl SimBody for XpbdBody {
     }
 
     fn substeps(&self) -> Option<Substeps> {
+        // The implicit scheme steps a frame its own way: it has no substeps to cut.
+        if self.body.solver().params().scheme != incise_sim::implicit::Scheme::Xpbd {
+            return None;
+        }
         Some(Substeps {
             now: self.body.solver().params().substeps,
             nominal: self.nominal,
@@ -414,6 +418,9 @@ impl SimBody for XpbdBody {
     }
 
     fn set_substeps(&mut self, n: u32) -> Result<()> {
+        if self.substeps().is_none() {
+            bail!("the implicit scheme has no substeps to set to {n}");
+        }
         let old = self.body.solver();
         if n == old.params().substeps {
             return Ok(());
@@ -483,7 +490,12 @@ mod tests {
 
     /// `config/plate_cut.ron` opened for a hand (the headset's controller).
     fn hand_plate() -> XpbdBody {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut.ron");
+        hand_body("config/plate_cut.ron")
+    }
+
+    /// The scene at `file` (from the repository root) opened for a hand.
+    fn hand_body(file: &str) -> XpbdBody {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
         let scene = crate::scene::load_scene(&path).unwrap();
         let opts = OpenOptions {
             device: DeviceChoice::Cpu,
@@ -559,5 +571,14 @@ mod tests {
         assert_eq!(b.time(), time, "the clock goes on");
         assert_eq!(after.tool().unwrap().to, pose, "the scalpel stays attached");
         assert!(b.set_substeps(s.nominal).is_ok());
+    }
+
+    /// The implicit scheme has no substeps for a pacer to cut (a retune would rebuild its
+    /// multigrid workspace for nothing).
+    #[test]
+    fn a_newton_body_has_no_substeps_to_cut() {
+        let mut b = hand_body("config/bowel_cantilever.ron");
+        assert_eq!(b.substeps(), None);
+        assert!(b.set_substeps(3).is_err());
     }
 }
