@@ -343,4 +343,39 @@ mod tests {
             "a 0.1 % damping change moved the body {apart} m of {moved}"
         );
     }
+
+    /// The panel's "only along the blade's edge" switch on a tearing scene: on (the edge
+    /// zone applied to the running body) the grab stretches the plate without releasing a
+    /// tet, the blade being parked away from it; off again, the same body tears where the
+    /// stress passes the threshold, as `incise run` does.
+    #[test]
+    fn the_edge_zone_switch_stops_and_restores_tearing() {
+        let gate = incise_test_gate::Need::Gpu;
+        let Some(dev) = incise_test_gate::or_skip(gate, RenderDevice::headless()) else {
+            return;
+        };
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_stretch.ron");
+        let mut s = Session::load(&path, DeviceChoice::Cpu, &dev).unwrap();
+        assert_eq!(s.params.cut_zone, CutZone::Anywhere, "the scene's own zone");
+        let released = |s: &Session| s.body.solver().cut().released_count();
+        let edge = LiveParams {
+            cut_zone: s.params.edge_zone,
+            ..s.params
+        };
+        s.apply(edge, DeviceChoice::Cpu, &dev).unwrap();
+        assert_eq!(s.body.solver().params().cut_zone, s.params.edge_zone);
+        for _ in 0..150 {
+            s.step().unwrap();
+        }
+        assert_eq!(released(&s), 0, "the edge zone tore the plate");
+        let anywhere = LiveParams {
+            cut_zone: CutZone::Anywhere,
+            ..s.params
+        };
+        s.apply(anywhere, DeviceChoice::Cpu, &dev).unwrap();
+        for _ in 0..5 {
+            s.step().unwrap();
+        }
+        assert!(released(&s) > 0, "switched off, the stretched plate tears");
+    }
 }
