@@ -209,11 +209,7 @@ fn open_options(scene: &Scene, device: DeviceChoice) -> Result<OpenOptions> {
 pub fn run(opts: &SoakOptions) -> Result<SoakReport> {
     let start = Instant::now();
     let scene = load_scene(&opts.scene)?;
-    let method = match scene.model {
-        ModelChoice::Xpbd => Method::Xpbd,
-        ModelChoice::MassSpring(_) => Method::Nakao,
-        ModelChoice::Rheology(_) => Method::Rheology,
-    };
+    let method = scene.model.method();
     let (cycles, device, replayed_free_nodes) =
         cut_for(opts, &open_options(&scene, opts.device)?, start)?;
     let verdict = judge(&cycles);

@@ -185,7 +185,7 @@ pub fn run(headset: &mut dyn Headset, live: LiveSim, mut plan: SessionPlan) -> R
     let shown = drive(headset, &mut s, &display);
     let attempts = (s.exercise.as_ref()).map_or(Vec::new(), |e| e.live.attempts.clone());
     let end = s.stepper.finish();
-    conclude(headset, end, shown, &plan, attempts)
+    conclude(headset, (s.method, end), shown, &plan, attempts)
 }
 
 /// After the display loop: the stroke, `report.json` (unless the session failed),
@@ -193,7 +193,7 @@ pub fn run(headset: &mut dyn Headset, live: LiveSim, mut plan: SessionPlan) -> R
 /// the session's failure (naming what was kept).
 fn conclude(
     headset: &dyn Headset,
-    end: Result<SteppingEnd>,
+    (method, end): (Method, Result<SteppingEnd>),
     mut shown: DisplayOutcome,
     plan: &SessionPlan,
     attempts: Vec<super::exercise::AttemptSummary>,
@@ -202,7 +202,7 @@ fn conclude(
     let mut end = match end {
         Ok(end) => end,
         Err(e) => {
-            let report = XrReport::new(Method::Xpbd, &shown.log, headset);
+            let report = XrReport::new(method, &shown.log, headset);
             report.save(&shown.log, out)?;
             return Err(xr_report::failed(e, shown.frames, "the frame log", out));
         }
