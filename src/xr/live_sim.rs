@@ -8,9 +8,9 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use super::pacing::{FramePacer, PacingConfig};
 use anyhow::Result;
 use incise_scalpel::{Stroke, StrokeRecorder};
-use incise_xr::openxr::pacing::{FramePacer, PacingConfig};
 
 use super::command::{BodyCommand, CommandStamp};
 use super::xr_report::{CutBox, cut_extent};

@@ -11,6 +11,7 @@ pub mod frame_loop;
 pub mod headset_sim;
 pub mod latest;
 pub mod live_sim;
+pub mod pacing;
 pub mod script;
 pub mod session;
 pub mod sim_mode;

@@ -13,9 +13,9 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use super::pacing::FramePacer;
 use anyhow::{Result, anyhow};
 use incise_sim::contact::ToolPose;
-use incise_xr::openxr::pacing::FramePacer;
 
 use super::command::{BodyCommand, CommandStamp};
 use super::latest::Latest;

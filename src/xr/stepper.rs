@@ -6,10 +6,10 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::pacing::FramePacer;
 use anyhow::Result;
 use incise_sim::contact::ToolPose;
 use incise_xr::openxr::HeadsetFrame;
-use incise_xr::openxr::pacing::FramePacer;
 
 use super::command::{Advanced, BodyCommand, CommandStamp};
 use super::live_sim::{LiveSim, Stepped};

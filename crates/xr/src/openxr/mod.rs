@@ -3,7 +3,7 @@
 //!
 //! Pure frame logic, tested without a runtime: [`pose`] (axes), [`eye`] (view and
 //! projection from `XrView`), [`tray`] (placement), [`scalpel_pose`] (controller → blade),
-//! [`haptics`], [`pacing`] (fixed simulation dt, substeps cut before time),
+//! [`haptics`],
 //! [`lifecycle`] (session states and the frame in flight), [`bindings`], [`controls`] and
 //! [`backdrop`] (passthrough, alpha blend or an opaque room).
 //! Runtime side: [`runtime`] (loader, instance, headset), [`manifest`] (which runtime), [`vulkan`] (Vulkan through the
@@ -20,7 +20,6 @@ pub mod haptics;
 pub mod headset;
 pub mod lifecycle;
 pub mod manifest;
-pub mod pacing;
 pub mod passthrough;
 pub mod pose;
 pub mod result_panel;
