@@ -12,6 +12,10 @@
 # minute or so (the full experiments against docs/experiments/, the large-scene docs
 # figures), about 3 minutes in all on 2 cores once the suite has built them. It needs no
 # GPU, browser or XR runtime, so it builds no Monado.
+#
+# `scripts/test-under-load.sh [ARGS]` runs this script (ARGS passed through) with one busy
+# loop per core beside it: the suite must pass with both cores of a 2-core machine busy
+# (tests of pacing and rates use a clock they own or ratios within one run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -336,14 +336,19 @@ fn a_failed_nakao_session_keeps_its_frame_log_and_xr_report() {
     );
 }
 
+/// How long every body frame is slowed in the real-time Nakao headset runs, ms (10× the
+/// body's 10 ms frame).
+const SLOW_BODY_MS: f64 = 100.0;
+
 /// `incise xr` on the Nakao plate with a real-time simulated headset and every body
-/// frame slowed by 40 ms (4× its 10 ms): `--sim`'s `mode`; the summary line.
+/// frame slowed by `SLOW_BODY_MS`: `--sim`'s `mode`; the summary line.
 fn slowed_realtime_headset(dir: &Path, mode: &str) -> Option<String> {
     let script = dir.join(format!("realtime-{mode}.ron"));
     let written = std::fs::read_to_string(self::script(dir, 0.8, "realtime: true,")).unwrap();
     std::fs::write(&script, written).unwrap();
     let out = dir.join(mode);
-    let slow = ["--sim", mode, "--slow-sim-ms", "40"];
+    let slow_ms = SLOW_BODY_MS.to_string();
+    let slow = ["--sim", mode, "--slow-sim-ms", &slow_ms];
     let o = run_xr("config/plate_cut_nakao.ron", &script, &out, &slow);
     if no_adapter(&o) {
         return None;
@@ -356,8 +361,12 @@ fn slowed_realtime_headset(dir: &Path, mode: &str) -> Option<String> {
 }
 
 /// A Nakao body on its own thread costs a real-time headset no wait: with every body
-/// frame slowed to 50 ms, a display frame stepped in the frame takes as long as the
-/// frames it steps, while with the body on its thread it only draws the newest one.
+/// frame slowed by 100 ms, a display frame stepped in the frame takes at least that long,
+/// while with the body on its thread it only draws the newest one. Each run is judged
+/// against the slowness it was given, not against the other run or a machine's speed: a
+/// frame that waited for the body takes ≥ 100 ms whatever the load, and one that did not
+/// takes its own drawing time (p50 under 0.01 ms measured with both cores busy, the body
+/// stepped in the frame over 300 ms).
 #[test]
 fn a_slow_nakao_body_on_its_thread_costs_the_headset_no_wait() {
     let dir = temp_dir("mh-nakao-thread");
@@ -372,8 +381,8 @@ fn a_slow_nakao_body_on_its_thread_costs_the_headset_no_wait() {
         number_after(&thread, "display frame work p50 "),
     );
     eprintln!("display frame work p50: in the frame {waits} ms, on a thread {free} ms");
-    assert!(waits >= 40.0, "in the frame: {in_frame}");
-    assert!(free < 20.0 && free * 2.0 < waits, "on a thread: {thread}");
+    assert!(waits >= SLOW_BODY_MS, "in the frame: {in_frame}");
+    assert!(free < 0.5 * SLOW_BODY_MS, "on a thread: {thread}");
 }
 
 #[test]

@@ -571,11 +571,17 @@ const SUMMARY_KEYS: [&str; 7] = [
     "frame_ms_p50_p95",
 ];
 
+/// How long `--slow-sim-ms` slows every simulation frame in the real-time runs, ms.
+const SLOW_SIM_MS: f64 = 250.0;
+
 /// Issue 19 item 3: with the solver on its own thread, a solver slowed by 250 ms a frame
-/// costs the display no frame (the same dropped frames as at full speed, within noise),
-/// while the simulation's steps per second fall below 4 and the tissue lags the tool by
-/// at least that step. The same slowness inside the frame loop drops many frames: the
-/// measure sees a display that waits.
+/// costs the display no frame: the display's own work per frame stays far under the slow
+/// step and it shows many frames for each simulation step, while the simulation's steps
+/// per second fall below 4 and the tissue lags the tool by at least that step. The same
+/// slowness inside the frame loop makes every display frame wait for it. Each run is
+/// judged on its own measures against the slowness it was given (issue 33 item 2), so
+/// the margins hold with both cores busy: a frame that waits for the solver takes
+/// ≥ 250 ms on any machine, one that does not takes its own drawing time.
 #[test]
 fn a_slow_solver_on_its_thread_costs_the_realtime_headset_no_frame() {
     let run = |name: &str, args: &[&str]| {
@@ -585,15 +591,19 @@ fn a_slow_solver_on_its_thread_costs_the_realtime_headset_no_frame() {
         assert_eq!(r["exit"], "Exited", "{name}: {r}");
         r
     };
+    let slow_ms = SLOW_SIM_MS.to_string();
     let base = run("xr-rt-base", &["--sim", "thread"]);
-    let slow = run("xr-rt-slow", &["--sim", "thread", "--slow-sim-ms", "250"]);
+    let slow = run(
+        "xr-rt-slow",
+        &["--sim", "thread", "--slow-sim-ms", &slow_ms],
+    );
     let waits = run(
         "xr-rt-in-frame",
-        &["--sim", "in-frame", "--slow-sim-ms", "250"],
+        &["--sim", "in-frame", "--slow-sim-ms", &slow_ms],
     );
     assert_eq!(base["sim_mode"], "thread", "{base}");
     assert_eq!(waits["sim_mode"], "in-frame", "{waits}");
-    assert_eq!(slow["slow_sim_ms"].as_u64(), Some(250), "{slow}");
+    assert_eq!(slow["slow_sim_ms"].as_f64(), Some(SLOW_SIM_MS), "{slow}");
     for (name, r) in [
         ("full speed", &base),
         ("slow", &slow),
@@ -610,16 +620,19 @@ fn a_slow_solver_on_its_thread_costs_the_realtime_headset_no_frame() {
         let shown = num(r, "frames") + num(r, "dropped_frames");
         assert!((150.0..=204.0).contains(&shown), "{shown} refreshes: {r}");
     }
-    // Other tests share the two cores: a few frames drop for them, not for the solver
-    // (a display that waits for a 70 ms step drops about four refreshes in five).
-    let (d_base, d_slow) = (num(&base, "dropped_frames"), num(&slow, "dropped_frames"));
+    let work_p95 = |r: &serde_json::Value| r["frame_ms_p50_p95"][1].as_f64().unwrap();
+    let work_p50 = |r: &serde_json::Value| r["frame_ms_p50_p95"][0].as_f64().unwrap();
+    // On its thread the slow solver holds up no display frame: 95 % of the frames take
+    // under half the slow step (a 64 px frame takes a few ms), and the display shows at
+    // least 5 frames for each simulation step (≤ 4 steps/s against a display that drops
+    // only frames its own drawing overran).
     assert!(
-        d_base < 50.0 && d_slow < 50.0,
-        "display frames dropped: {d_base} at full speed, {d_slow} slow"
+        work_p95(&slow) < 0.5 * SLOW_SIM_MS,
+        "the display waited for the slow solver: {slow}"
     );
     assert!(
-        d_slow <= d_base + 3.0 + 0.05 * 202.0,
-        "the slow solver dropped display frames: {d_slow} vs {d_base} at full speed\n{slow}\n{base}"
+        num(&slow, "frames") >= 5.0 * num(&slow, "sim_frames"),
+        "the display showed few frames beside the slow solver: {slow}"
     );
     // Fewer steps, and the tissue shown lags the tool by at least the slow step.
     assert_slow_sim_steps_less_and_lags(&slow, &base);
@@ -628,10 +641,13 @@ fn a_slow_solver_on_its_thread_costs_the_realtime_headset_no_frame() {
         0.0,
         "in the frame the tissue keeps up: {waits}"
     );
-    // Stepping the slow solver inside the frame makes the display wait: frames drop.
+    // Stepping the slow solver inside the frame makes the display wait: each frame takes
+    // the slow step and the refreshes it spans drop (≥ 17 of every 18 at 72 Hz).
+    assert!(work_p50(&waits) >= SLOW_SIM_MS, "in-frame: {waits}");
+    let refreshes = num(&waits, "frames") + num(&waits, "dropped_frames");
     assert!(
-        num(&waits, "dropped_frames") > d_slow + 50.0,
-        "in-frame {} vs thread {d_slow} dropped frames",
+        num(&waits, "dropped_frames") >= 0.8 * refreshes,
+        "in-frame: {} of {refreshes} refreshes dropped",
         num(&waits, "dropped_frames")
     );
 }

@@ -276,10 +276,16 @@ fn steady_dropped(out: &std::path::Path, r: &Value) -> f64 {
 }
 
 /// Issue 19 item 3 on a real runtime: with the solver on its own thread (the default),
-/// a solver slowed by 250 ms a frame costs Monado's display no frame (the same dropped
-/// frames as at full speed, within noise) while the simulation's steps per second fall
-/// below 4. The same slowness stepped inside the frame loop (`--sim in-frame`) drops
-/// many, or makes Monado stretch its period: the measure sees a display that waits.
+/// a solver slowed by 250 ms a frame costs Monado's display no frame: its own work per
+/// frame stays far under the slow step, Monado keeps its 20 Hz and the display shows
+/// several frames per simulation step, while the simulation's steps per second fall
+/// below 4. The same slowness stepped inside the frame loop (`--sim in-frame`) makes
+/// every frame wait for it and drops more refreshes than it shows. Each run is judged
+/// against the slowness it was given, not against another run's dropped frames (issue
+/// 33 item 2): with both cores busy a full-speed run drops a few refreshes too.
+/// How long `--slow-sim-ms` slows every simulation frame in the slow-solver runs, ms.
+const SLOW_SIM_MS: f64 = 250.0;
+
 #[test]
 fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
     let Some(manifest) = monado::monado() else {
@@ -312,8 +318,12 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
         r
     };
     let base = run("base", &[]);
-    let slow = run("slow", &["--slow-sim-ms", "250"]);
-    let waits = run("in-frame", &["--sim", "in-frame", "--slow-sim-ms", "250"]);
+    let slow_ms = SLOW_SIM_MS.to_string();
+    let slow = run("slow", &["--slow-sim-ms", &slow_ms]);
+    let waits = run(
+        "in-frame",
+        &["--sim", "in-frame", "--slow-sim-ms", &slow_ms],
+    );
     assert_eq!(base["sim_mode"], "thread", "the default: {base}");
     assert_eq!(waits["sim_mode"], "in-frame", "{waits}");
     for (name, r) in [
@@ -338,28 +348,25 @@ fn a_slow_solver_on_its_thread_costs_monado_no_display_frame() {
         );
     }
     // Monado stretches the period it predicts for an app that is late; a display that
-    // never waits keeps the null compositor's 20 Hz and, once started, drops few of its
-    // refreshes.
+    // never waits keeps the null compositor's 20 Hz. On its thread the slow solver holds
+    // up no frame: 95 % of the frames take under half the slow step (8–53 ms measured
+    // with both cores busy), and the display shows at least 3 frames per step (5 measured).
+    let work = |r: &Value, q: usize| r["frame_ms_p50_p95"][q].as_f64().unwrap();
     for r in [&base, &slow] {
-        assert!(
-            num(r, "display_hz") > 15.0 && num(r, "steady_dropped") < 8.0,
-            "the display waited: {r}"
-        );
+        assert!(num(r, "display_hz") > 15.0, "the display waited: {r}");
     }
     assert!(
-        num(&slow, "display_hz") >= 0.9 * num(&base, "display_hz"),
-        "the runtime slowed down for the slow solver\n{slow}\n{base}"
+        work(&slow, 1) < 0.5 * SLOW_SIM_MS,
+        "the display waited for the slow solver: {slow}"
     );
-    let (d_base, d_slow) = (num(&base, "steady_dropped"), num(&slow, "steady_dropped"));
     assert!(
-        d_slow <= d_base + 3.0,
-        "the slow solver dropped display frames: {d_slow} vs {d_base} at full speed\n{slow}\n{base}"
+        num(&slow, "frames") >= 3.0 * num(&slow, "sim_frames"),
+        "the display showed few frames beside the slow solver: {slow}"
     );
     // Fewer steps, and the tissue shown lags the tool by at least the slow step.
     assert_slow_sim_steps_less_and_lags(&slow, &base);
     assert!(
-        num(&waits, "dropped_frames") > d_slow + 20.0
-            || num(&waits, "display_hz") < 0.5 * num(&slow, "display_hz"),
+        work(&waits, 0) >= SLOW_SIM_MS && num(&waits, "dropped_frames") > num(&waits, "frames"),
         "in-frame: {waits}"
     );
 }
