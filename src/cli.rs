@@ -1,6 +1,6 @@
 //! Command-line interface definition (clap).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -43,7 +43,8 @@ pub enum Command {
     Xr(XrArgs),
     /// Render one frame of a scene offscreen to a PNG (no window needed).
     Render {
-        /// Scene file (RON).
+        /// Scene file (RON) or a built-in scene's name.
+        #[arg(value_parser = config_file)]
         scene: PathBuf,
         /// Frames to simulate before rendering (0: the rest state).
         #[arg(long, default_value_t = 0)]
@@ -62,7 +63,8 @@ pub enum Command {
     },
     /// Run a scene on the CPU and the GPU side by side; exit 1 if they disagree.
     Compare {
-        /// Scene file (RON).
+        /// Scene file (RON) or a built-in scene's name.
+        #[arg(value_parser = config_file)]
         scene: PathBuf,
         /// Frames to compare.
         #[arg(long, default_value_t = 200)]
@@ -109,7 +111,7 @@ pub enum Command {
         #[arg(long)]
         scaling: bool,
         /// Scene of the `realtime` and `scene` targets.
-        #[arg(long, default_value = "config/intestine_pull.ron")]
+        #[arg(long, default_value = DEFAULT_SCENE, value_parser = config_file)]
         scene: PathBuf,
         /// CPU solver threads of the `realtime` target (default: all cores).
         #[arg(long)]
@@ -125,6 +127,7 @@ pub enum Command {
     /// fails (exit 1) if memory grows > 5 %, file descriptors leak or a cut differs.
     Soak {
         /// Scene file with a tool and a stroke, e.g. config/plate_cut.ron.
+        #[arg(value_parser = config_file)]
         scene: PathBuf,
         /// Wall-clock duration in seconds (at least three cuts are made).
         #[arg(long, default_value_t = 3600.0)]
@@ -145,10 +148,11 @@ pub enum Command {
     /// attempt to the results history.
     Exercise {
         /// Exercise file (RON), e.g. config/exercises/slab_depth.ron.
+        #[arg(value_parser = config_file)]
         exercise: PathBuf,
         /// Stroke file (RON timed poses: recorded with `incise run --record-stroke`, or
         /// scripted).
-        #[arg(long, required_unless_present = "reference_stroke")]
+        #[arg(long, required_unless_present = "reference_stroke", value_parser = config_file)]
         stroke: Option<PathBuf>,
         /// Instead of scoring, write the exercise's reference stroke (the scene's scalpel
         /// along the plan at the target depth, handle raised `--tilt`) to this file.
@@ -371,7 +375,8 @@ fn positive_rate(s: &str) -> Result<f64, String> {
 /// `incise run`'s arguments.
 #[derive(Debug, Clone, clap::Args)]
 pub struct RunArgs {
-    /// Scene file (RON), e.g. config/intestine_pull.ron.
+    /// Scene file (RON) or a built-in scene's name, e.g. config/intestine_pull.ron.
+    #[arg(value_parser = config_file)]
     pub scene: PathBuf,
     /// Frames to simulate (default: the scene's duration at its frame rate).
     #[arg(long)]
@@ -426,8 +431,9 @@ pub struct RunArgs {
 /// `incise preview`'s arguments.
 #[derive(Debug, Clone, clap::Args)]
 pub struct PreviewArgs {
-    /// Scene file (RON); default config/intestine_pull.ron.
-    pub scene: Option<PathBuf>,
+    /// Scene file (RON) or a built-in scene's name.
+    #[arg(default_value = DEFAULT_SCENE, value_parser = config_file)]
+    pub scene: PathBuf,
     /// Render this many frames, then exit.
     #[arg(long)]
     pub frames: Option<u64>,
@@ -443,18 +449,19 @@ pub struct PreviewArgs {
     /// Open this exercise (config/exercises/*.ron): its scene, the planned incision
     /// drawn on the tissue, attempts scored and saved to out/exercises/ and
     /// results/history.jsonl.
-    #[arg(long, conflicts_with = "scene")]
+    #[arg(long, conflicts_with = "scene", value_parser = config_file)]
     pub exercise: Option<PathBuf>,
 }
 
 /// `incise xr`'s arguments.
 #[derive(Debug, Clone, clap::Args)]
 pub struct XrArgs {
-    /// Scene file (RON); default config/plate_cut.ron.
-    pub scene: Option<PathBuf>,
+    /// Scene file (RON) or a built-in scene's name.
+    #[arg(default_value = XR_SCENE, value_parser = config_file)]
+    pub scene: PathBuf,
     /// Run without a runtime on this headset script (RON: head, controller and
     /// button tracks), rendering both eyes offscreen.
-    #[arg(long)]
+    #[arg(long, value_parser = config_file)]
     pub simulated_headset: Option<PathBuf>,
     /// Output folder: frames.csv (frame times), xr_report.json, stroke.ron, eye PNGs.
     #[arg(long, default_value = "out/xr")]
@@ -471,7 +478,7 @@ pub struct XrArgs {
     /// Training exercise (e.g. config/exercises/slab_depth.ron): its scene with the plan
     /// drawn on the tissue; A finishes an attempt (scored, saved under OUT/attempts/,
     /// the result card shown above the tray), A again starts over.
-    #[arg(long, conflicts_with = "scene")]
+    #[arg(long, conflicts_with = "scene", value_parser = config_file)]
     pub exercise: Option<PathBuf>,
     /// Results history exercise attempts are appended to.
     #[arg(long, default_value = "results/history.jsonl")]
@@ -502,7 +509,7 @@ pub struct XrArgs {
 impl From<RunArgs> for RunOptions {
     fn from(a: RunArgs) -> Self {
         RunOptions {
-            scene: resolve(&a.scene),
+            scene: a.scene,
             frames: a.frames,
             out: a.out,
             vtu_every: a.vtu_every,
@@ -525,12 +532,12 @@ impl From<RunArgs> for RunOptions {
 impl From<PreviewArgs> for PreviewOptions {
     fn from(a: PreviewArgs) -> Self {
         PreviewOptions {
-            scene: resolve(&a.scene.unwrap_or_else(|| DEFAULT_SCENE.into())),
+            scene: a.scene,
             frames: a.frames,
             screenshot: a.screenshot,
             device: a.device,
             size: a.size,
-            exercise: a.exercise.as_deref().map(resolve),
+            exercise: a.exercise,
         }
     }
 }
@@ -538,13 +545,13 @@ impl From<PreviewArgs> for PreviewOptions {
 impl From<XrArgs> for XrOptions {
     fn from(a: XrArgs) -> Self {
         XrOptions {
-            scene: resolve(&a.scene.unwrap_or_else(|| XR_SCENE.into())),
-            simulated: a.simulated_headset.as_deref().map(resolve),
+            scene: a.scene,
+            simulated: a.simulated_headset,
             out: a.out,
             record_stroke: a.record_stroke,
             frames: a.frames,
             device: a.device,
-            exercise: a.exercise.as_deref().map(resolve),
+            exercise: a.exercise,
             history: a.history,
             inject_nan_at: a.inject_nan_at,
             stroke: a.stroke,
@@ -553,6 +560,13 @@ impl From<XrArgs> for XrOptions {
             inject_sim_panic_at: a.inject_sim_panic_at,
         }
     }
+}
+
+/// A file argument as given, else the built-in file of that name
+/// ([`crate::scene::built_in::resolve`]): `incise run intestine_pull` works from any
+/// folder.
+fn config_file(arg: &str) -> Result<PathBuf, String> {
+    Ok(resolve(Path::new(arg)))
 }
 
 impl Command {

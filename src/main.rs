@@ -8,7 +8,7 @@ use incise::cli::{BenchTarget, Cli, Command, ExperimentCommand, MeshCommand, Sce
 use incise::pictures::render_command;
 use incise::preview;
 use incise::run::run_scene;
-use incise::scene::built_in::{self, resolve};
+use incise::scene::built_in;
 use incise::{compare, exercise, experiment, mesh_cmd};
 
 fn main() -> ExitCode {
@@ -38,14 +38,14 @@ fn main() -> ExitCode {
             size,
             overlay,
             device,
-        } => render_command::render_frame(&resolve(&scene), frame, &out, size, &overlay, device)
+        } => render_command::render_frame(&scene, frame, &out, size, &overlay, device)
             .map(|()| println!("wrote {}", out.display())),
         Command::Compare {
             scene,
             frames,
             threads,
             json,
-        } => compare::run(&resolve(&scene), frames, threads, json),
+        } => compare::run(&scene, frames, threads, json),
         Command::Mesh { command } => match command {
             MeshCommand::Check { file, json } => mesh_cmd::check(&file, json),
             MeshCommand::Gen { kind, out } => mesh_cmd::generate(kind, &out),
@@ -71,7 +71,7 @@ fn main() -> ExitCode {
             markdown,
             ..
         } => bench_realtime::run(
-            &resolve(&scene),
+            &scene,
             device,
             (
                 threads,
@@ -90,7 +90,7 @@ fn main() -> ExitCode {
             markdown,
             ..
         } => bench::scene::run(
-            &resolve(&scene),
+            &scene,
             device,
             frames,
             bench::BenchOutput::of(json, markdown),
@@ -118,7 +118,7 @@ fn main() -> ExitCode {
             out,
             markdown,
         } => incise::bench::soak::run(&incise::bench::soak::SoakOptions {
-            scene: resolve(&scene),
+            scene,
             seconds,
             device,
             out: out.clone(),
@@ -129,7 +129,7 @@ fn main() -> ExitCode {
             reference_stroke: Some(file),
             tilt,
             ..
-        } => exercise::write_reference_stroke(&resolve(&exercise), &file, tilt).map(|()| {
+        } => exercise::write_reference_stroke(&exercise, &file, tilt).map(|()| {
             println!("wrote {}", file.display());
         }),
         Command::Exercise {
@@ -141,8 +141,8 @@ fn main() -> ExitCode {
             quiet,
             ..
         } => exercise::run_exercise(&exercise::ExerciseOptions {
-            exercise: resolve(&exercise),
-            stroke: resolve(&stroke),
+            exercise,
+            stroke,
             out,
             device,
             history: history.clone(),

@@ -103,6 +103,25 @@ fn shipped_scenes_run_by_name_and_by_config_path_from_any_directory() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(dir.join("attempt/result.json").is_file());
 
+    // The headset on a built-in scene and a built-in headset script, both by name: every
+    // command's file arguments resolve the same way.
+    let o = incise_in(
+        &dir,
+        &cache,
+        &[
+            "xr",
+            "plate_cut",
+            "--simulated-headset",
+            "xr/plate_cut_headset",
+            "--frames",
+            "3",
+            "--out",
+            "xr_out",
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(dir.join("xr_out/xr_report.json").is_file());
+
     // A name that is neither a file nor built in fails naming it, once.
     let o = incise_in(&dir, &cache, &["run", "no_such_scene", "--frames", "1"]);
     assert!(!o.status.success());
