@@ -71,7 +71,7 @@ impl BodyDrawing {
                 positions: &c.positions,
                 device_displacements: None,
                 cut: &c.cut,
-                von_mises: &c.von_mises,
+                heat: &c.von_mises,
                 pinned: &c.pinned,
             },
         }

@@ -70,7 +70,7 @@ impl TetDrawing {
             positions: &self.view.positions,
             device_displacements: None,
             cut: &self.render.cut,
-            von_mises: &self.per_tet,
+            heat: &self.per_tet,
             pinned: &[],
         }
     }

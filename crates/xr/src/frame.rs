@@ -16,8 +16,9 @@ pub struct BodyState<'a> {
     pub device_displacements: Option<&'a wgpu::Buffer>,
     /// Live tets, visible faces and their changes.
     pub cut: &'a CutState,
-    /// von Mises stress per tet (mesh order), Pa.
-    pub von_mises: &'a [f32],
+    /// The heat map's value per tet (mesh order), in the body's own quantity (an XPBD
+    /// body's von Mises stress, Pa; a Nakao body's tension; a rheology body's strain).
+    pub heat: &'a [f32],
     /// Pinned nodes (drawn by the pinned-nodes overlay).
     pub pinned: &'a [u32],
 }
@@ -30,7 +31,7 @@ impl<'a> BodyState<'a> {
             positions: solver.positions(),
             device_displacements: None,
             cut: solver.cut(),
-            von_mises: solver.von_mises(),
+            heat: solver.von_mises(),
             pinned,
         }
     }
@@ -58,7 +59,7 @@ impl UncutBody {
             positions,
             device_displacements: None,
             cut: &self.cut,
-            von_mises: &self.von_mises,
+            heat: &self.von_mises,
             pinned: &[],
         }
     }

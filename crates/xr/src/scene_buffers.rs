@@ -297,12 +297,8 @@ impl SceneBuffers {
             }
         }
         if settings.overlays.stress {
-            let t = self.tets.len().min(state.von_mises.len());
-            queue.write_buffer(
-                &self.von_mises,
-                0,
-                bytemuck::cast_slice(&state.von_mises[..t]),
-            );
+            let t = self.tets.len().min(state.heat.len());
+            queue.write_buffer(&self.von_mises, 0, bytemuck::cast_slice(&state.heat[..t]));
         }
         let released = state.cut.released_count();
         let mut grown = false;
