@@ -5,7 +5,7 @@
 mod common;
 
 use glam::{DVec3, UVec3, Vec3};
-use incise_sim::implicit::{NewtonParams, Scheme};
+use incise_sim::implicit::{CoarseRefresh, NewtonParams, Scheme};
 use incise_sim::xpbd::ConstraintPair;
 use incise_sim::{Solver, SolverParams};
 
@@ -17,6 +17,7 @@ const CONVERGED: NewtonParams = NewtonParams {
     cg_tolerance: 1e-3,
     gradient_tolerance: 0.0,
     coarse_cell: None,
+    coarse_refresh: CoarseRefresh::Rest,
 };
 
 /// A 20 × 2 × 2 cm cantilever (E = 3 MPa, ν = 0.45) pinned at x = 0 under gravity settles

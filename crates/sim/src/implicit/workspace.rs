@@ -14,9 +14,10 @@
 use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
+use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
 use super::coarse_system::{CoarseError, CoarseSystem, RestTet};
-use super::params::NewtonParams;
+use super::params::{CoarseRefresh, NewtonParams};
 use super::pcg::{dot, pcg};
 use super::product_lanes::{RestLanes, TangentLanes, product, rest_lanes, tangent_lanes};
 use super::tet_tangent::TetTangent;
@@ -47,6 +48,10 @@ pub struct NewtonReport {
     /// `|∇G|` where the last iteration started (or where the gradient stop ended the step)
     /// over `|∇G|` at the step's first iterate (free nodes, 2-norm).
     pub gradient_ratio: f32,
+    /// Whether the coarse matrix was re-assembled from the current tangents this step.
+    pub coarse_refreshed: bool,
+    /// Whether that refresh was not positive definite (the previous factor was kept).
+    pub coarse_refresh_failed: bool,
 }
 
 /// One tet's evaluation at the current iterate.
@@ -79,6 +84,13 @@ struct TwoLevel {
     diag_inv: Vec<Mat3>,
     grid: CoarseGrid,
     coarse: CoarseSystem,
+    /// The tets' corner pairs for re-assembling `coarse` (`None` under
+    /// [`CoarseRefresh::Rest`]).
+    assembly: Option<CoarseAssembly>,
+    /// The tangents of the last refresh, per tet (what a release subtracts).
+    used: Vec<TetTangent>,
+    /// Steps since the last refresh.
+    since_refresh: u32,
     rhs: Vec<f64>,
 }
 
@@ -123,6 +135,8 @@ impl NewtonWorkspace {
             energy: 0.0,
         };
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
+        let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
+            .then(|| CoarseAssembly::new(&grid, &tets, &b, coarse.block_index()));
         let lanes = lanes.then(|| {
             let rest = rest_lanes(&tets, &b);
             let tangents = vec![tangent_lanes(0, |_| rest_tangent(lame)); rest.len()];
@@ -147,6 +161,9 @@ impl NewtonWorkspace {
                 rhs: vec![0.0; 3 * grid.count],
                 grid,
                 coarse,
+                assembly,
+                used: Vec::new(),
+                since_refresh: 0,
             },
             gradient: vec![Vec3::ZERO; n],
             rhs: vec![Vec3::ZERO; n],
@@ -161,8 +178,13 @@ impl NewtonWorkspace {
         (self.pre.grid.count, self.pre.coarse.nonzeros())
     }
 
-    /// Take released tets (mesh indices) out of the coarse matrix.
+    /// Take released tets (mesh indices) out of the coarse matrix: their rest stiffness
+    /// (before any refresh) or their blocks at the last refresh's tangents.
     pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
+        let pre = &mut self.pre;
+        if let (Some(assembly), false) = (&pre.assembly, pre.used.is_empty()) {
+            return pre.coarse.release_refreshed(assembly, tets, &pre.used);
+        }
         let gone: Vec<RestTet> = tets
             .iter()
             .map(|&t| self.hessian.tets[t as usize])
@@ -184,6 +206,22 @@ impl NewtonWorkspace {
     ) {
         let mut report = NewtonReport::default();
         let mut g_now = self.hessian.evaluate(u, y, live, free, parallel);
+        if self.refresh_due() {
+            let evals = &self.hessian.evals;
+            let tangent = |t: usize| live[t].then(|| &evals[t].tangent);
+            let pre = &mut self.pre;
+            let assembly = pre
+                .assembly
+                .as_mut()
+                .expect("a refresh policy has an assembly");
+            report.coarse_refreshed = true;
+            report.coarse_refresh_failed = pre.coarse.refresh(assembly, tangent, parallel).is_err();
+            // The blocks are these tangents' even where the factor stayed the old one.
+            pre.used.clear();
+            pre.used.extend(evals.iter().map(|e| e.tangent));
+            pre.since_refresh = 0;
+        }
+        self.pre.since_refresh += 1;
         let mut first_norm = None;
         for _ in 0..self.params.iterations {
             self.hessian.gather_gradient(
@@ -229,6 +267,21 @@ impl NewtonWorkspace {
             }
         }
         self.last = report;
+    }
+
+    /// Whether this step re-assembles the coarse matrix (module docs, [`CoarseRefresh`]).
+    fn refresh_due(&self) -> bool {
+        let pre = &self.pre;
+        if pre.assembly.is_none() {
+            return false;
+        }
+        match self.params.coarse_refresh {
+            CoarseRefresh::Rest => false,
+            CoarseRefresh::Steps(n) => pre.since_refresh >= n,
+            CoarseRefresh::Products(bound) => {
+                self.last.cg_products > bound * self.last.iterations.max(1)
+            }
+        }
     }
 
     /// Backtrack along the direction from `u` until `G` decreases enough; on success `u`
