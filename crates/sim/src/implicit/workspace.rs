@@ -286,7 +286,8 @@ impl NewtonWorkspace {
 
     /// Backtrack along the direction from `u` until `G` decreases enough; on success `u`
     /// moves there and the tet evaluations are the new point's, else `u` stays and they
-    /// are `u`'s again. Returns the new `G`.
+    /// are `u`'s again. Returns the new `G`. The full step is evaluated in full (it is
+    /// usually taken); a halved one only for its energy, and in full once taken.
     #[allow(clippy::too_many_arguments)]
     fn line_search(
         &mut self,
@@ -302,12 +303,19 @@ impl NewtonWorkspace {
         let mut alpha = 1.0f32;
         // f32 energies summed in f64: changes below this are rounding.
         let rounding = 1e-6 * g_now.abs();
-        for _ in 0..=MAX_HALVINGS {
+        for halving in 0..=MAX_HALVINGS {
             for ((t, u), d) in self.trial.iter_mut().zip(u.iter()).zip(&self.direction) {
                 *t = *u + alpha * *d;
             }
-            let g_trial = self.hessian.evaluate(&self.trial, y, live, free, parallel);
+            let g_trial = if halving == 0 {
+                self.hessian.evaluate(&self.trial, y, live, free, parallel)
+            } else {
+                self.hessian.energy(&self.trial, y, live, free, parallel)
+            };
             if g_trial <= g_now + ARMIJO * alpha as f64 * slope + rounding {
+                if halving > 0 {
+                    self.hessian.evaluate(&self.trial, y, live, free, parallel);
+                }
                 u.copy_from_slice(&self.trial);
                 return Some(g_trial);
             }
@@ -356,6 +364,37 @@ impl Hessian {
                 *t = tangent_lanes(chunk.len(), |k| chunk[k].tangent);
             });
         }
+        self.total(u, y, free)
+    }
+
+    /// `G(u)` alone: only the tets' energies are updated (their forces, diagonal blocks
+    /// and tangents stay those of the last [`Hessian::evaluate`]); the same value
+    /// `evaluate` returns, to the bit.
+    fn energy(
+        &mut self,
+        u: &[Vec3],
+        y: &[Vec3],
+        live: &[bool],
+        free: &[bool],
+        parallel: bool,
+    ) -> f64 {
+        let (tets, lame) = (&self.tets, self.lame);
+        let eval = |t: usize, out: &mut TetEval| {
+            out.energy = if live[t] {
+                let tet = &tets[t];
+                let du = tet.nodes.map(|i| u[i as usize]);
+                let s = Strain::of(displacement_gradient(&du, &tet.dm_inv));
+                tet.volume * energy_density(&s, lame)
+            } else {
+                0.0
+            };
+        };
+        for_each(parallel, &mut self.evals, eval);
+        self.total(u, y, free)
+    }
+
+    /// `G` from the tets' energies and the inertia at `u`.
+    fn total(&self, u: &[Vec3], y: &[Vec3], free: &[bool]) -> f64 {
         let elastic: f64 = self.evals.iter().map(|e| e.energy as f64).sum();
         let inertia: f64 = (0..u.len())
             .filter(|&i| free[i])
