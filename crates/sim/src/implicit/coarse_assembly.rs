@@ -169,14 +169,6 @@ impl CoarseAssembly {
         &self.beta[self.corner_offsets[t] as usize..self.corner_offsets[t + 1] as usize]
     }
 
-    /// Corner pairs over all tets (the work of a refresh, in blocks).
-    pub fn pairs(&self) -> usize {
-        self.groups
-            .iter()
-            .map(|g| g.slots.len() * (g.chunks.len() * LANES))
-            .sum()
-    }
-
     /// `out = base + Σ` over the tets with a tangent (`tangent(t)` is `None` for a
     /// released tet) of their Galerkin blocks, row-major per block; eight tets of a group
     /// at a time in SIMD lanes (AVX2 where the CPU has it).
@@ -422,7 +414,7 @@ fn tet_corners(grid: &CoarseGrid, t: &RestTet, b: &[Vec3; 4]) -> Vec<(u32, Vec3)
             }
         }
     }
-    corners.sort_unstable_by(|x, y| y.0.cmp(&x.0));
+    corners.sort_unstable_by_key(|c| std::cmp::Reverse(c.0));
     corners
 }
 

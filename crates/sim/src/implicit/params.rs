@@ -41,7 +41,8 @@ pub struct NewtonParams {
     pub gradient_tolerance: f32,
     /// Edge of the coarse level's cubes, m (`None`: four mean rest edge lengths).
     pub coarse_cell: Option<f32>,
-    /// Which stiffness the coarse level's matrix holds and when it is rebuilt.
+    /// Which stiffness the coarse level's matrix holds and when it is rebuilt (default:
+    /// the current tangents every 8 steps, docs/physics-notes.md "The implicit scheme").
     pub coarse_refresh: CoarseRefresh,
 }
 
@@ -70,7 +71,7 @@ impl Default for NewtonParams {
             cg_tolerance: 0.1,
             gradient_tolerance: 0.01,
             coarse_cell: None,
-            coarse_refresh: CoarseRefresh::Rest,
+            coarse_refresh: CoarseRefresh::Steps(8),
         }
     }
 }
