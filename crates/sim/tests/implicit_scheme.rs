@@ -1,11 +1,13 @@
 //! The implicit scheme (`solver.scheme: Newton`, `incise_sim::implicit`): a cantilever
 //! settles on the static solution of its own mesh, a bar pulled until it tears tears as
-//! the XPBD reference does, and unusable settings are refused naming the field.
+//! the XPBD reference does (with the coarse level at rest stiffness and refreshed from the
+//! current tangents), a refreshed coarse level saves products on a bent beam, and unusable
+//! settings are refused naming the field.
 
 mod common;
 
 use glam::{DVec3, UVec3, Vec3};
-use incise_sim::implicit::{NewtonParams, Scheme};
+use incise_sim::implicit::{CoarseRefresh, NewtonParams, Scheme};
 use incise_sim::xpbd::ConstraintPair;
 use incise_sim::{Solver, SolverParams};
 
@@ -17,6 +19,7 @@ const CONVERGED: NewtonParams = NewtonParams {
     cg_tolerance: 1e-3,
     gradient_tolerance: 0.0,
     coarse_cell: None,
+    coarse_refresh: CoarseRefresh::Rest,
 };
 
 /// A 20 × 2 × 2 cm cantilever (E = 3 MPa, ν = 0.45) pinned at x = 0 under gravity settles
@@ -95,23 +98,97 @@ fn a_pulled_bar_tears_as_the_xpbd_reference_does() {
     // Steps as long as the release interval (1/240 s): a step of a whole frame releases
     // a frame's overstress at once, and the bar's cascade then runs further (1,148
     // released against 670; docs/physics-notes.md, "The implicit scheme").
-    let (first, released, s) = run(common::tearing_bar_with(|p| {
-        p.threads = 1;
-        p.scheme = Scheme::Newton(NewtonParams {
-            steps: 4,
-            ..CONVERGED
-        });
-    }));
-    let (ref_first, first) = (ref_first.expect("XPBD tears"), first.expect("Newton tears"));
-    assert!(
-        first.abs_diff(ref_first) <= 2,
-        "first release {first} against {ref_first}"
+    let ref_first = ref_first.expect("XPBD tears");
+    // The refreshed coarse level spans the cut with cubes too: it must not hold the two
+    // sides together (it only preconditions; a released tet drops out of it).
+    for coarse_refresh in [CoarseRefresh::Rest, CoarseRefresh::Steps(1)] {
+        let (first, released, s) = run(common::tearing_bar_with(|p| {
+            p.threads = 1;
+            p.scheme = Scheme::Newton(NewtonParams {
+                steps: 4,
+                coarse_refresh,
+                ..CONVERGED
+            });
+        }));
+        let first = first.expect("Newton tears");
+        assert!(
+            first.abs_diff(ref_first) <= 2,
+            "{coarse_refresh:?}: first release {first} against {ref_first}"
+        );
+        let off = released.abs_diff(ref_released) as f64 / ref_released as f64;
+        assert!(
+            off <= 0.15,
+            "{coarse_refresh:?}: {released} released against {ref_released}"
+        );
+        // The cut is open: the live tets fall into two or more pieces.
+        let comps =
+            incise_sim::mesh::topology::connected_components(s.mesh(), |t| s.cut().is_live(t));
+        assert!(
+            comps >= 2,
+            "{coarse_refresh:?}: the bar is still in one piece after tearing"
+        );
+    }
+}
+
+/// A soft cantilever bent a quarter of its length under gravity: the rest stiffness
+/// misses the rotation of its tets, so the coarse level refreshed from the current
+/// tangents needs fewer products a frame once bent, and both settle on the same sag.
+#[test]
+fn a_refreshed_coarse_level_saves_products_on_a_bent_beam() {
+    let mesh = common::block_mesh(
+        Vec3::new(0.0, -0.01, -0.01),
+        Vec3::new(0.2, 0.02, 0.02),
+        UVec3::new(20, 2, 2),
     );
-    let off = released.abs_diff(ref_released) as f64 / ref_released as f64;
-    assert!(off <= 0.15, "{released} released against {ref_released}");
-    // The cut is open: the live tets fall into two or more pieces.
-    let comps = incise_sim::mesh::topology::connected_components(s.mesh(), |t| s.cut().is_live(t));
-    assert!(comps >= 2, "the bar is still in one piece after tearing");
+    let root: Vec<u32> = (0..mesh.node_count() as u32)
+        .filter(|&i| mesh.rest_positions[i as usize].x < 1e-4)
+        .collect();
+    let tip: Vec<usize> = (0..mesh.node_count())
+        .filter(|&i| mesh.rest_positions[i].x > 0.2 - 1e-4)
+        .collect();
+    let run = |coarse_refresh| {
+        let params = SolverParams {
+            scheme: Scheme::Newton(NewtonParams {
+                cg_tolerance: 1e-2,
+                gradient_tolerance: 1e-3,
+                coarse_refresh,
+                ..CONVERGED
+            }),
+            damping: 20.0,
+            threads: 1,
+            ..SolverParams::default()
+        };
+        let mut s = Solver::new(mesh.clone(), common::soft(1e5, 0.45), params).unwrap();
+        s.pin(&root);
+        let mut late_products = 0;
+        for f in 0..60 {
+            let st = s.step_frame().unwrap();
+            if f >= 30 {
+                late_products += st.cg_products;
+            }
+        }
+        let x = s.positions();
+        let sag = -tip
+            .iter()
+            .map(|&i| x[i].z - mesh.rest_positions[i].z)
+            .sum::<f32>()
+            / tip.len() as f32;
+        (late_products, sag)
+    };
+    let (rest, rest_sag) = run(CoarseRefresh::Rest);
+    let (fresh, fresh_sag) = run(CoarseRefresh::Steps(1));
+    assert!(
+        rest_sag > 0.05,
+        "bent a quarter of its length: sag {rest_sag} m"
+    );
+    assert!(
+        (fresh_sag / rest_sag - 1.0).abs() < 0.01,
+        "sag {fresh_sag} refreshed against {rest_sag} at rest stiffness"
+    );
+    assert!(
+        (fresh as f64) < 0.8 * rest as f64,
+        "products over frames 30-59: {fresh} refreshed against {rest} at rest stiffness"
+    );
 }
 
 /// Settings the scheme cannot use are refused with the field named.
@@ -140,6 +217,14 @@ fn unusable_newton_settings_are_refused() {
         ..SolverParams::default()
     };
     assert!(try_with(bad_tolerance).contains("solver.scheme.cg_tolerance"));
+    let never = SolverParams {
+        scheme: Scheme::Newton(NewtonParams {
+            coarse_refresh: CoarseRefresh::Steps(0),
+            ..NewtonParams::default()
+        }),
+        ..SolverParams::default()
+    };
+    assert!(try_with(never).contains("solver.scheme.coarse_refresh"));
     let seed_pair = SolverParams {
         scheme: Scheme::Newton(NewtonParams::default()),
         constraints: ConstraintPair::GammaShifted,
@@ -152,10 +237,17 @@ fn unusable_newton_settings_are_refused() {
 /// is evaluated from `H`, so rest is force-free to the last bit), at ν up to 0.499.
 #[test]
 fn rest_stays_exactly_at_rest() {
-    for nu in [0.0, 0.3, 0.45, 0.499] {
+    let policies = [CoarseRefresh::Rest, CoarseRefresh::Steps(1)];
+    for (nu, coarse_refresh) in [0.0, 0.3, 0.45, 0.499]
+        .into_iter()
+        .flat_map(|nu| policies.map(|p| (nu, p)))
+    {
         let mesh = common::block_mesh(Vec3::ZERO, Vec3::new(0.03, 0.02, 0.01), UVec3::new(6, 4, 2));
         let params = SolverParams {
-            scheme: Scheme::Newton(NewtonParams::default()),
+            scheme: Scheme::Newton(NewtonParams {
+                coarse_refresh,
+                ..NewtonParams::default()
+            }),
             gravity: Vec3::ZERO,
             threads: 1,
             ..SolverParams::default()
@@ -166,7 +258,7 @@ fn rest_stays_exactly_at_rest() {
             s.step_frame().unwrap();
         }
         let moved = common::max_displacement(&s);
-        assert_eq!(moved, 0.0, "ν = {nu}: moved {moved} m");
+        assert_eq!(moved, 0.0, "ν = {nu}, {coarse_refresh:?}: moved {moved} m");
     }
 }
 

@@ -1,11 +1,13 @@
 //! The coarse level's matrix `A_c = Pᵀ A P` (Galerkin) and its sparse Cholesky factor.
 //!
-//! `A` is `M/h² + K`, with `K` the small-strain (rest) stiffness of the live tets, so the
+//! `A` is `M/h² + K`, with `K` first the small-strain (rest) stiffness of the tets, so the
 //! pattern is fixed from the start: a released tet only subtracts its own contribution
 //! and the factor is refreshed numerically on the same symbolic analysis
 //! (`../shared/SOLVERS.md`, "a cut that only releases tets never changes the sparsity
-//! pattern"). The fine level corrects what the rest stiffness gets wrong (rotations,
-//! large strain): this is only the preconditioner's coarse part.
+//! pattern"). [`CoarseSystem::refresh`] re-assembles `K` from the live tets' current
+//! tangents on the same pattern ([`CoarseAssembly`]), so the coarse level follows the
+//! rotations and large strains the rest stiffness gets wrong; the fine level corrects the
+//! rest either way: this is only the preconditioner's coarse part.
 
 use std::collections::HashMap;
 
@@ -15,7 +17,9 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{MatMut, Side};
 use glam::{Mat3, Vec3};
 
+use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
+use super::tet_tangent::TetTangent;
 use crate::material::Lame;
 use crate::vbd::shape_gradients;
 
@@ -54,6 +58,8 @@ pub struct CoarseSystem {
     index: HashMap<(u32, u32), usize>,
     /// Row-major 3×3 values of each block.
     blocks: Vec<[f64; 9]>,
+    /// The mass part `Pᵀ (M/h²) P` of each block (what a refresh adds the tets to).
+    mass_blocks: Vec<[f64; 9]>,
     /// Per block, the position of each of its nine values in the CSC values (`u32::MAX`
     /// above the diagonal of a diagonal block).
     position: Vec<[u32; 9]>,
@@ -75,18 +81,21 @@ impl CoarseSystem {
     ) -> Result<Self, CoarseError> {
         let mut index = HashMap::new();
         let mut blocks = Vec::new();
-        let mut add = |v: u32, w: u32, b: Mat3, scale: f64| {
-            let k = *index.entry((v, w)).or_insert_with(|| {
-                blocks.push([0.0; 9]);
-                blocks.len() - 1
-            });
-            accumulate(&mut blocks[k], &b, scale);
-        };
         for t in tets {
-            tet_contribution(grid, t, lame, &mut |v, w, b| add(v, w, b, 1.0));
+            tet_contribution(grid, t, lame, &mut |v, w, b| {
+                add_block(&mut index, &mut blocks, (v, w), &b);
+            });
         }
         for (i, w) in grid.weights.iter().enumerate() {
-            node_mass(w, mass[i] * inv_h2, &mut |v, u, b| add(v, u, b, 1.0));
+            node_mass(w, mass[i] * inv_h2, &mut |v, u, b| {
+                add_block(&mut index, &mut blocks, (v, u), &b);
+            });
+        }
+        let mut mass_blocks = vec![[0.0; 9]; blocks.len()];
+        for (i, w) in grid.weights.iter().enumerate() {
+            node_mass(w, mass[i] * inv_h2, &mut |v, u, b| {
+                accumulate(&mut mass_blocks[index[&(v, u)]], &b, 1.0);
+            });
         }
         let n = 3 * grid.count;
         let (col_ptr, row_idx, position) = pattern(&index, grid.count);
@@ -98,6 +107,7 @@ impl CoarseSystem {
         Ok(CoarseSystem {
             index,
             blocks,
+            mass_blocks,
             position,
             col_ptr,
             row_idx,
@@ -124,6 +134,38 @@ impl CoarseSystem {
         self.refactor()
     }
 
+    /// Re-assemble the matrix from the mass and the tets' current tangents (`tangent(t)`
+    /// `None` for a released tet) and refactorise on the same pattern; when the new matrix
+    /// is not positive definite the previous factor stays and the error says so.
+    pub fn refresh<'a>(
+        &mut self,
+        assembly: &mut CoarseAssembly,
+        tangent: impl Fn(usize) -> Option<&'a TetTangent> + Sync,
+        parallel: bool,
+    ) -> Result<(), CoarseError> {
+        assembly.assemble(&self.mass_blocks, tangent, &mut self.blocks, parallel);
+        self.refactor()
+    }
+
+    /// Subtract released tets' blocks at the tangents `used` (per tet, those of the last
+    /// [`CoarseSystem::refresh`]) and refactorise on the same pattern.
+    pub fn release_refreshed(
+        &mut self,
+        assembly: &CoarseAssembly,
+        tets: &[u32],
+        used: &[TetTangent],
+    ) -> Result<(), CoarseError> {
+        for &t in tets {
+            assembly.add_tet(t as usize, &used[t as usize], -1.0, &mut self.blocks);
+        }
+        self.refactor()
+    }
+
+    /// Lower-triangle coarse block `(row, col)` → its index (what [`CoarseAssembly`] reads).
+    pub fn block_index(&self) -> &HashMap<(u32, u32), usize> {
+        &self.index
+    }
+
     /// Solve `A_c x = b` in place (3 values per coarse node).
     pub fn solve(&self, b: &mut [f64]) {
         let n = b.len();
@@ -136,9 +178,10 @@ impl CoarseSystem {
         self.row_idx.len()
     }
 
-    /// Copy the blocks into the CSC values and factorise numerically.
+    /// Copy the blocks into the CSC values and factorise numerically (the previous factor
+    /// stays when this fails).
     fn refactor(&mut self) -> Result<(), CoarseError> {
-        self.values = block_values(&self.blocks, &self.position, self.row_idx.len());
+        fill_block_values(&self.blocks, &self.position, &mut self.values);
         self.factor = factorise(&self.symbolic, &self.col_ptr, &self.row_idx, &self.values)?;
         Ok(())
     }
@@ -147,6 +190,12 @@ impl CoarseSystem {
 /// The CSC values of `blocks` placed at `position`.
 fn block_values(blocks: &[[f64; 9]], position: &[[u32; 9]], len: usize) -> Vec<f64> {
     let mut values = vec![0.0; len];
+    fill_block_values(blocks, position, &mut values);
+    values
+}
+
+/// Write `blocks` into the CSC `values` at `position`.
+fn fill_block_values(blocks: &[[f64; 9]], position: &[[u32; 9]], values: &mut [f64]) {
     for (b, pos) in blocks.iter().zip(position) {
         for k in 0..9 {
             if pos[k] != u32::MAX {
@@ -154,7 +203,6 @@ fn block_values(blocks: &[[f64; 9]], position: &[[u32; 9]], len: usize) -> Vec<f
             }
         }
     }
-    values
 }
 
 /// The numeric LLᵀ factor of the lower-triangle CSC matrix on `symbolic`'s analysis.
@@ -172,6 +220,20 @@ fn factorise(
         Side::Lower,
     )
     .map_err(|e| CoarseError(format!("{e:?}")))
+}
+
+/// Add `m` to block `(v, w)`, numbering it if it is new.
+fn add_block(
+    index: &mut HashMap<(u32, u32), usize>,
+    blocks: &mut Vec<[f64; 9]>,
+    vw: (u32, u32),
+    m: &Mat3,
+) {
+    let k = *index.entry(vw).or_insert_with(|| {
+        blocks.push([0.0; 9]);
+        blocks.len() - 1
+    });
+    accumulate(&mut blocks[k], m, 1.0);
 }
 
 /// `b += scale · m` in row-major order.

@@ -4,6 +4,7 @@
 //! Galerkin coarse grid). The tet solver ([`crate::xpbd::Solver`]) drives them when
 //! `solver.scheme` is `Newton`.
 
+mod coarse_assembly;
 mod coarse_grid;
 mod coarse_system;
 mod params;
@@ -14,7 +15,7 @@ mod workspace;
 
 pub use coarse_grid::CoarseGrid;
 pub use coarse_system::{CoarseError, CoarseSystem, RestTet};
-pub use params::{NewtonParams, Scheme};
+pub use params::{CoarseRefresh, NewtonParams, Scheme};
 pub use pcg::{CgReport, dot, pcg};
 pub use tet_tangent::TetTangent;
 pub use workspace::{NewtonReport, NewtonWorkspace};

@@ -41,6 +41,25 @@ pub struct NewtonParams {
     pub gradient_tolerance: f32,
     /// Edge of the coarse level's cubes, m (`None`: four mean rest edge lengths).
     pub coarse_cell: Option<f32>,
+    /// Which stiffness the coarse level's matrix holds and when it is rebuilt (default:
+    /// the current tangents every 8 steps, docs/physics-notes.md "The implicit scheme").
+    pub coarse_refresh: CoarseRefresh,
+}
+
+/// The stiffness in the coarse level's Galerkin matrix `Pᵀ (M/h² + K) P`
+/// (`solver.scheme: Newton((coarse_refresh: …))`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CoarseRefresh {
+    /// The small-strain (rest) stiffness, factorised once; a released tet subtracts its
+    /// own. It fits less and less as the body rotates and stretches.
+    Rest,
+    /// The live tets' current tangents, re-assembled and refactorised at the first
+    /// iterate of every n-th implicit step; a released tet subtracts its blocks at the
+    /// tangent they were assembled with.
+    Steps(u32),
+    /// The current tangents, re-assembled at the first iterate of a step after one that
+    /// spent more than this many conjugate-gradient products per Newton iteration.
+    Products(u32),
 }
 
 impl Default for NewtonParams {
@@ -52,6 +71,7 @@ impl Default for NewtonParams {
             cg_tolerance: 0.1,
             gradient_tolerance: 0.01,
             coarse_cell: None,
+            coarse_refresh: CoarseRefresh::Steps(8),
         }
     }
 }
@@ -97,6 +117,12 @@ impl NewtonParams {
                 ));
             }
         }
-        Ok(())
+        match self.coarse_refresh {
+            CoarseRefresh::Steps(0) | CoarseRefresh::Products(0) => Err((
+                "scheme.coarse_refresh",
+                "must be Rest, Steps(n) or Products(n) with n ≥ 1, got 0".to_string(),
+            )),
+            _ => Ok(()),
+        }
     }
 }

@@ -14,9 +14,10 @@
 use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
+use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
 use super::coarse_system::{CoarseError, CoarseSystem, RestTet};
-use super::params::NewtonParams;
+use super::params::{CoarseRefresh, NewtonParams};
 use super::pcg::{dot, pcg};
 use super::product_lanes::{RestLanes, TangentLanes, product, rest_lanes, tangent_lanes};
 use super::tet_tangent::TetTangent;
@@ -47,6 +48,10 @@ pub struct NewtonReport {
     /// `|∇G|` where the last iteration started (or where the gradient stop ended the step)
     /// over `|∇G|` at the step's first iterate (free nodes, 2-norm).
     pub gradient_ratio: f32,
+    /// Whether the coarse matrix was re-assembled from the current tangents this step.
+    pub coarse_refreshed: bool,
+    /// Whether that refresh was not positive definite (the previous factor was kept).
+    pub coarse_refresh_failed: bool,
 }
 
 /// One tet's evaluation at the current iterate.
@@ -79,6 +84,13 @@ struct TwoLevel {
     diag_inv: Vec<Mat3>,
     grid: CoarseGrid,
     coarse: CoarseSystem,
+    /// The tets' corner pairs for re-assembling `coarse` (`None` under
+    /// [`CoarseRefresh::Rest`]).
+    assembly: Option<CoarseAssembly>,
+    /// The tangents of the last refresh, per tet (what a release subtracts).
+    used: Vec<TetTangent>,
+    /// Steps since the last refresh.
+    since_refresh: u32,
     rhs: Vec<f64>,
 }
 
@@ -123,6 +135,8 @@ impl NewtonWorkspace {
             energy: 0.0,
         };
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
+        let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
+            .then(|| CoarseAssembly::new(&grid, &tets, &b, coarse.block_index()));
         let lanes = lanes.then(|| {
             let rest = rest_lanes(&tets, &b);
             let tangents = vec![tangent_lanes(0, |_| rest_tangent(lame)); rest.len()];
@@ -147,6 +161,9 @@ impl NewtonWorkspace {
                 rhs: vec![0.0; 3 * grid.count],
                 grid,
                 coarse,
+                assembly,
+                used: Vec::new(),
+                since_refresh: 0,
             },
             gradient: vec![Vec3::ZERO; n],
             rhs: vec![Vec3::ZERO; n],
@@ -161,8 +178,13 @@ impl NewtonWorkspace {
         (self.pre.grid.count, self.pre.coarse.nonzeros())
     }
 
-    /// Take released tets (mesh indices) out of the coarse matrix.
+    /// Take released tets (mesh indices) out of the coarse matrix: their rest stiffness
+    /// (before any refresh) or their blocks at the last refresh's tangents.
     pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
+        let pre = &mut self.pre;
+        if let (Some(assembly), false) = (&pre.assembly, pre.used.is_empty()) {
+            return pre.coarse.release_refreshed(assembly, tets, &pre.used);
+        }
         let gone: Vec<RestTet> = tets
             .iter()
             .map(|&t| self.hessian.tets[t as usize])
@@ -184,6 +206,22 @@ impl NewtonWorkspace {
     ) {
         let mut report = NewtonReport::default();
         let mut g_now = self.hessian.evaluate(u, y, live, free, parallel);
+        if self.refresh_due() {
+            let evals = &self.hessian.evals;
+            let tangent = |t: usize| live[t].then(|| &evals[t].tangent);
+            let pre = &mut self.pre;
+            let assembly = pre
+                .assembly
+                .as_mut()
+                .expect("a refresh policy has an assembly");
+            report.coarse_refreshed = true;
+            report.coarse_refresh_failed = pre.coarse.refresh(assembly, tangent, parallel).is_err();
+            // The blocks are these tangents' even where the factor stayed the old one.
+            pre.used.clear();
+            pre.used.extend(evals.iter().map(|e| e.tangent));
+            pre.since_refresh = 0;
+        }
+        self.pre.since_refresh += 1;
         let mut first_norm = None;
         for _ in 0..self.params.iterations {
             self.hessian.gather_gradient(
@@ -231,9 +269,25 @@ impl NewtonWorkspace {
         self.last = report;
     }
 
+    /// Whether this step re-assembles the coarse matrix (module docs, [`CoarseRefresh`]).
+    fn refresh_due(&self) -> bool {
+        let pre = &self.pre;
+        if pre.assembly.is_none() {
+            return false;
+        }
+        match self.params.coarse_refresh {
+            CoarseRefresh::Rest => false,
+            CoarseRefresh::Steps(n) => pre.since_refresh >= n,
+            CoarseRefresh::Products(bound) => {
+                self.last.cg_products > bound * self.last.iterations.max(1)
+            }
+        }
+    }
+
     /// Backtrack along the direction from `u` until `G` decreases enough; on success `u`
     /// moves there and the tet evaluations are the new point's, else `u` stays and they
-    /// are `u`'s again. Returns the new `G`.
+    /// are `u`'s again. Returns the new `G`. The full step is evaluated in full (it is
+    /// usually taken); a halved one only for its energy, and in full once taken.
     #[allow(clippy::too_many_arguments)]
     fn line_search(
         &mut self,
@@ -249,12 +303,19 @@ impl NewtonWorkspace {
         let mut alpha = 1.0f32;
         // f32 energies summed in f64: changes below this are rounding.
         let rounding = 1e-6 * g_now.abs();
-        for _ in 0..=MAX_HALVINGS {
+        for halving in 0..=MAX_HALVINGS {
             for ((t, u), d) in self.trial.iter_mut().zip(u.iter()).zip(&self.direction) {
                 *t = *u + alpha * *d;
             }
-            let g_trial = self.hessian.evaluate(&self.trial, y, live, free, parallel);
+            let g_trial = if halving == 0 {
+                self.hessian.evaluate(&self.trial, y, live, free, parallel)
+            } else {
+                self.hessian.energy(&self.trial, y, live, free, parallel)
+            };
             if g_trial <= g_now + ARMIJO * alpha as f64 * slope + rounding {
+                if halving > 0 {
+                    self.hessian.evaluate(&self.trial, y, live, free, parallel);
+                }
                 u.copy_from_slice(&self.trial);
                 return Some(g_trial);
             }
@@ -303,6 +364,37 @@ impl Hessian {
                 *t = tangent_lanes(chunk.len(), |k| chunk[k].tangent);
             });
         }
+        self.total(u, y, free)
+    }
+
+    /// `G(u)` alone: only the tets' energies are updated (their forces, diagonal blocks
+    /// and tangents stay those of the last [`Hessian::evaluate`]); the same value
+    /// `evaluate` returns, to the bit.
+    fn energy(
+        &mut self,
+        u: &[Vec3],
+        y: &[Vec3],
+        live: &[bool],
+        free: &[bool],
+        parallel: bool,
+    ) -> f64 {
+        let (tets, lame) = (&self.tets, self.lame);
+        let eval = |t: usize, out: &mut TetEval| {
+            out.energy = if live[t] {
+                let tet = &tets[t];
+                let du = tet.nodes.map(|i| u[i as usize]);
+                let s = Strain::of(displacement_gradient(&du, &tet.dm_inv));
+                tet.volume * energy_density(&s, lame)
+            } else {
+                0.0
+            };
+        };
+        for_each(parallel, &mut self.evals, eval);
+        self.total(u, y, free)
+    }
+
+    /// `G` from the tets' energies and the inertia at `u`.
+    fn total(&self, u: &[Vec3], y: &[Vec3], free: &[bool]) -> f64 {
         let elastic: f64 = self.evals.iter().map(|e| e.energy as f64).sum();
         let inertia: f64 = (0..u.len())
             .filter(|&i| free[i])

@@ -41,4 +41,8 @@ pub struct FrameStats {
     /// Parallel passes of the frame: on the CPU the colour and stress passes (each ends
     /// in a synchronisation of the threads), on the GPU the compute dispatches.
     pub passes: u32,
+    /// Conjugate-gradient products of the frame's Newton iterations (0 under XPBD).
+    pub cg_products: u32,
+    /// Implicit steps of the frame that re-assembled the coarse matrix (0 under XPBD).
+    pub coarse_refreshes: u32,
 }

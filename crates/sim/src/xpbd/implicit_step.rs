@@ -51,6 +51,7 @@ impl Solver {
         let mut fresh = false;
         self.check_ms = 0.0;
         self.passes = checks.len() as u32;
+        self.implicit_cost = (0, 0);
         for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
@@ -72,6 +73,8 @@ impl Solver {
             if let Some(ws) = &mut self.newton {
                 ws.solve(&mut self.u, &y, &live, &free, parallel);
                 let r = ws.last;
+                self.implicit_cost.0 += r.cg_products;
+                self.implicit_cost.1 += u32::from(r.coarse_refreshed);
                 // A tet pass and a node pass per evaluation, product and gather.
                 self.passes +=
                     2 * (1 + r.iterations + r.halvings) + 2 * r.cg_products + r.iterations;

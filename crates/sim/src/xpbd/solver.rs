@@ -91,6 +91,8 @@ pub struct Solver {
     pub(crate) check_ms: f64,
     /// Parallel passes of the last frame (colours per substep, stress passes).
     pub(crate) passes: u32,
+    /// The last frame's conjugate-gradient products and coarse refreshes (Newton).
+    pub(crate) implicit_cost: (u32, u32),
     pub(crate) pool: Option<rayon::ThreadPool>,
     /// The implicit scheme's buffers and preconditioner, built at its first step (when
     /// the pins and grabs are known).
@@ -185,6 +187,7 @@ impl Solver {
             time: 0.0,
             check_ms: 0.0,
             passes: 0,
+            implicit_cost: (0, 0),
             pool,
             newton: None,
             lame,
@@ -836,6 +839,8 @@ impl Solver {
             check_ms: 0.0,
             stress_ms: 0.0,
             passes: self.passes,
+            cg_products: self.implicit_cost.0,
+            coarse_refreshes: self.implicit_cost.1,
         }
     }
 }
