@@ -4,16 +4,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/ensure-deps.sh
-# Built for this machine's CPU (AVX2/AVX-512 SIMD lanes for the tet projection: the default
-# scene's frame is 1.6x faster than the portable build, docs/performance.md), in its own
-# target folder so the portable build of the tests is not rebuilt. INCISE_PORTABLE=1: the
-# portable build.
-if [ "${INCISE_PORTABLE:-0}" = 1 ]; then
-    target=target
-    cargo build --release --locked
-else
+# The portable release build, the one scripts/test.sh builds too, so the README's two
+# commands compile the workspace once: the solver's SIMD lanes pick AVX2 at run time, as
+# fast on the default scene as a -C target-cpu=native build (docs/performance.md,
+# "Portable or built for the CPU"). INCISE_NATIVE=1: a build for this CPU in target/native.
+if [ "${INCISE_NATIVE:-0}" = 1 ]; then
     target=target/native
     RUSTFLAGS="${RUSTFLAGS:-} -C target-cpu=native" cargo build --release --locked --target-dir "$target"
+else
+    target=target
+    cargo build --release --locked
 fi
 scene="${1:-config/intestine_pull.ron}"
 out="out/$(basename "$scene" .ron)"
