@@ -25,7 +25,7 @@ use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
 use super::coarse_grid::CoarseGrid;
-use super::coarse_system::RestTet;
+use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::xpbd::lanes::{LANES, Lane, M3, V3, store_vec};
 

@@ -19,6 +19,7 @@ use glam::{Mat3, Vec3};
 
 use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
+use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
 use crate::vbd::shape_gradients;
@@ -27,30 +28,6 @@ use crate::vbd::shape_gradients;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("the coarse level of the implicit solver could not be factorised: {0}")]
 pub struct CoarseError(String);
-
-/// One tet as the coarse assembly reads it.
-#[derive(Debug, Clone, Copy)]
-pub struct RestTet {
-    /// Its four nodes.
-    pub nodes: [u32; 4],
-    /// Inverse rest shape matrix.
-    pub dm_inv: Mat3,
-    /// Rest volume, m³.
-    pub volume: f32,
-}
-
-impl RestTet {
-    /// Every tet of `mesh`, in mesh order.
-    pub fn all(mesh: &crate::mesh::TetMesh) -> Vec<RestTet> {
-        (0..mesh.tet_count())
-            .map(|t| RestTet {
-                nodes: mesh.tets[t],
-                dm_inv: mesh.dm_inv[t],
-                volume: mesh.rest_volume[t],
-            })
-            .collect()
-    }
-}
 
 /// `A_c` in 3×3 blocks (lower triangle) and its factor.
 pub struct CoarseSystem {

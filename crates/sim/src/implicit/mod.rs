@@ -10,12 +10,14 @@ mod coarse_system;
 mod params;
 mod pcg;
 mod product_lanes;
+mod rest_tet;
 mod tet_tangent;
 mod workspace;
 
 pub use coarse_grid::CoarseGrid;
-pub use coarse_system::{CoarseError, CoarseSystem, RestTet};
+pub use coarse_system::{CoarseError, CoarseSystem};
 pub use params::{CoarseRefresh, NewtonParams, Scheme};
 pub use pcg::{CgReport, dot, pcg};
+pub use rest_tet::RestTet;
 pub use tet_tangent::TetTangent;
 pub use workspace::{NewtonReport, NewtonWorkspace};

@@ -7,7 +7,7 @@
 
 use glam::{Mat3, Vec3};
 
-use super::coarse_system::RestTet;
+use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::xpbd::lanes::{LANES, Lane, M3, V3, store_mat, store_vec};
 

@@ -16,10 +16,11 @@ use rayon::prelude::*;
 
 use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
-use super::coarse_system::{CoarseError, CoarseSystem, RestTet};
+use super::coarse_system::{CoarseError, CoarseSystem};
 use super::params::{CoarseRefresh, NewtonParams};
 use super::pcg::{dot, pcg};
 use super::product_lanes::{RestLanes, TangentLanes, product, rest_lanes, tangent_lanes};
+use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
 use crate::mesh::TetMesh;
