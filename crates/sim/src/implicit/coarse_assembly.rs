@@ -421,10 +421,8 @@ fn tet_corners(grid: &CoarseGrid, t: &RestTet, b: &[Vec3; 4]) -> Vec<(u32, Vec3)
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::generate::block;
     use crate::implicit::CoarseSystem;
     use crate::material::Lame;
-    use crate::mesh::TetMesh;
     use crate::vbd::shape_gradients;
     use crate::xpbd::{Strain, displacement_gradient};
 
@@ -432,16 +430,8 @@ mod tests {
     /// product `dP[dF]`, at a stretched, sheared and rotated state with some tets released.
     #[test]
     fn the_refresh_is_the_galerkin_product_of_the_current_tangent() {
-        let raw = block(
-            Vec3::ZERO,
-            Vec3::new(0.04, 0.02, 0.01),
-            glam::UVec3::new(8, 4, 2),
-        );
-        let mesh = TetMesh::from_raw(raw).unwrap().0;
+        let (mesh, grid, tets) = crate::implicit::coarse_grid::test_block();
         let n = mesh.node_count();
-        let free: Vec<bool> = (0..n).map(|i| mesh.rest_positions[i].x > 1e-4).collect();
-        let grid = CoarseGrid::new(&mesh.rest_positions, &free, 0.012);
-        let tets = RestTet::all(&mesh);
         let lame = Lame {
             mu: 6.2e4,
             lambda: 5.59e5,

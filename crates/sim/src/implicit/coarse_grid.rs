@@ -190,6 +190,28 @@ fn trilinear(t: Vec3, c: UVec3) -> f32 {
     axis(t.x, c.x) * axis(t.y, c.y) * axis(t.z, c.z)
 }
 
+/// A 4 × 2 × 1 cm block of tets with its x = 0 face fixed, on a 12 mm coarse grid: the
+/// mesh, the grid and the tets (the coarse level's tests).
+#[cfg(test)]
+pub(crate) fn test_block() -> (
+    crate::mesh::TetMesh,
+    CoarseGrid,
+    Vec<super::rest_tet::RestTet>,
+) {
+    let raw = crate::generate::block(
+        Vec3::ZERO,
+        Vec3::new(0.04, 0.02, 0.01),
+        glam::UVec3::new(8, 4, 2),
+    );
+    let mesh = crate::mesh::TetMesh::from_raw(raw).unwrap().0;
+    let free: Vec<bool> = (0..mesh.node_count())
+        .map(|i| mesh.rest_positions[i].x > 1e-4)
+        .collect();
+    let grid = CoarseGrid::new(&mesh.rest_positions, &free, 0.012);
+    let tets = super::rest_tet::RestTet::all(&mesh);
+    (mesh, grid, tets)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

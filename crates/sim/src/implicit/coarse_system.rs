@@ -313,8 +313,6 @@ fn pattern(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::generate::block;
-    use crate::mesh::TetMesh;
 
     fn lame() -> Lame {
         Lame {
@@ -326,16 +324,7 @@ mod tests {
     /// The coarse matrix of a block of tets against `Pᵀ A P` formed densely.
     #[test]
     fn the_coarse_matrix_is_the_galerkin_product_and_factorises() {
-        let raw = block(
-            Vec3::ZERO,
-            Vec3::new(0.04, 0.02, 0.01),
-            glam::UVec3::new(8, 4, 2),
-        );
-        let mesh = TetMesh::from_raw(raw).unwrap().0;
-        let n = mesh.node_count();
-        let free: Vec<bool> = (0..n).map(|i| mesh.rest_positions[i].x > 1e-4).collect();
-        let grid = CoarseGrid::new(&mesh.rest_positions, &free, 0.012);
-        let tets = RestTet::all(&mesh);
+        let (mesh, grid, tets) = crate::implicit::coarse_grid::test_block();
         let mass = mesh.lumped_masses(1040.0);
         let sys = CoarseSystem::new(&grid, &tets, &mass, 3600.0, lame()).unwrap();
         let nc = 3 * grid.count;
