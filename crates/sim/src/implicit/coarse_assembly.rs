@@ -424,7 +424,6 @@ mod tests {
     use crate::implicit::CoarseSystem;
     use crate::material::Lame;
     use crate::vbd::shape_gradients;
-    use crate::xpbd::{Strain, displacement_gradient};
 
     /// The refreshed blocks against `Pᵀ K(x) P` formed densely from the tangent's own
     /// product `dP[dF]`, at a stretched, sheared and rotated state with some tets released.
@@ -454,10 +453,7 @@ mod tests {
             .collect();
         let tangents: Vec<TetTangent> = tets
             .iter()
-            .map(|t| {
-                let du = t.nodes.map(|i| u[i as usize]);
-                TetTangent::at(&Strain::of(displacement_gradient(&du, &t.dm_inv)), lame)
-            })
+            .map(|t| TetTangent::at(&t.strain(&u), lame))
             .collect();
         let live: Vec<bool> = (0..tets.len()).map(|t| t % 7 != 2).collect();
         let mut out = vec![[0.0; 9]; sys.block_index().len()];

@@ -1,7 +1,9 @@
 //! A tet as the implicit scheme's coarse level and Hessian product read it: its nodes,
 //! inverse rest shape matrix and rest volume, copied out of the mesh once.
 
-use glam::Mat3;
+use glam::{Mat3, Vec3};
+
+use crate::xpbd::{Strain, displacement_gradient};
 
 /// One tet as the coarse assembly reads it.
 #[derive(Debug, Clone, Copy)]
@@ -24,5 +26,11 @@ impl RestTet {
                 volume: mesh.rest_volume[t],
             })
             .collect()
+    }
+
+    /// Its strain at the nodes' displacements `u` (PHYSICS.md §1.2: `F = I + Du Dm⁻¹`).
+    pub fn strain(&self, u: &[Vec3]) -> Strain {
+        let du = self.nodes.map(|i| u[i as usize]);
+        Strain::of(displacement_gradient(&du, &self.dm_inv))
     }
 }

@@ -347,8 +347,7 @@ impl Hessian {
                 return;
             }
             let tet = &tets[t];
-            let du = tet.nodes.map(|i| u[i as usize]);
-            let s = Strain::of(displacement_gradient(&du, &tet.dm_inv));
+            let s = tet.strain(u);
             let p = piola(&s, lame) * tet.volume;
             out.tangent = TetTangent::at(&s, lame);
             out.energy = tet.volume * energy_density(&s, lame);
@@ -383,9 +382,7 @@ impl Hessian {
         let eval = |t: usize, out: &mut TetEval| {
             out.energy = if live[t] {
                 let tet = &tets[t];
-                let du = tet.nodes.map(|i| u[i as usize]);
-                let s = Strain::of(displacement_gradient(&du, &tet.dm_inv));
-                tet.volume * energy_density(&s, lame)
+                tet.volume * energy_density(&tet.strain(u), lame)
             } else {
                 0.0
             };
