@@ -72,7 +72,7 @@ impl BodyDrawing {
                 device_displacements: None,
                 cut: &c.cut,
                 heat: &c.von_mises,
-                pinned: &c.pinned,
+                pinned: &c.shape.pinned,
             },
         }
     }

@@ -19,12 +19,15 @@ pub enum BodyView {
     Cut(CutView),
 }
 
-/// The fixed mesh of a [`CutView`] and the skin embedded in it, shared by all its frames.
+/// The fixed mesh of a [`CutView`], the skin embedded in it and its pins, shared by all
+/// its frames.
 pub struct CutShape {
     /// The tet mesh.
     pub mesh: TetMesh,
     /// The skin drawn over it.
     pub skin: Skin,
+    /// Pinned nodes (drawn by the pinned-nodes overlay).
+    pub pinned: Vec<u32>,
 }
 
 /// A frame of a body with a fixed mesh: positions, the cut and the heat map.
@@ -39,8 +42,6 @@ pub struct CutView {
     pub cut: Arc<CutState>,
     /// von Mises stress per tet, Pa.
     pub von_mises: Vec<f32>,
-    /// Pinned nodes.
-    pub pinned: Arc<Vec<u32>>,
     /// Full scale of the stress heat map, Pa.
     pub stress_max: f32,
 }

@@ -3,7 +3,7 @@
 //! tets released where the von Mises stress passes the threshold.
 
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use anyhow::{Result, bail};
 use glam::{Quat, Vec3};
@@ -49,14 +49,14 @@ pub struct XpbdBody {
     held: bool,
     /// Whether a hand holds the tool from the start (the scene's stroke is not played).
     hand: bool,
-    /// The mesh and skin every drawn frame shares.
-    shape: Arc<CutShape>,
-    /// The pinned nodes (drawn by the pinned-nodes overlay).
-    pinned: Arc<Vec<u32>>,
-    /// The material, the scene's substeps and the fewest stable ones (for a retune).
+    /// The mesh, skin and pins every drawn frame shares, made when a frame is first drawn
+    /// (a run that draws none does not copy the mesh).
+    shape: OnceLock<Arc<CutShape>>,
+    /// The material, the scene's substeps and the fewest stable ones (for a retune; the
+    /// fewest found when a pacer first asks).
     material: Material,
     nominal: u32,
-    fewest: u32,
+    fewest: OnceLock<u32>,
     /// The GPU context the body was put on, to put a retuned solver on.
     gpu: Option<GpuContext>,
 }
@@ -122,13 +122,7 @@ pub fn open(
         material,
         ..
     } = built;
-    let shape = Arc::new(CutShape {
-        mesh: solver.mesh().clone(),
-        skin: skin.clone(),
-    });
-    let pinned = Arc::new(incise_xr::frame::pinned_nodes(&solver));
     let nominal = solver.params().substeps;
-    let fewest = solver.fewest_stable_substeps().clamp(1, nominal);
     let body = Body::place_on(solver, opts.device, opts.gpu.as_ref(), |m| {
         choice = Some(m.to_string())
     })?;
@@ -150,11 +144,10 @@ pub fn open(
             lifted: waiting,
             held: !waiting,
             hand: opts.hand,
-            shape,
-            pinned,
+            shape: OnceLock::new(),
             material,
             nominal,
-            fewest,
+            fewest: OnceLock::new(),
             gpu: opts.gpu.clone(),
         },
         report,
@@ -387,20 +380,27 @@ impl SimBody for XpbdBody {
 
     fn view(&self, previous: Option<&CutView>) -> BodyView {
         let s = self.body.solver();
+        let shape = self.shape.get_or_init(|| {
+            Arc::new(CutShape {
+                mesh: s.mesh().clone(),
+                skin: self.skin.clone(),
+                pinned: incise_xr::frame::pinned_nodes(s),
+            })
+        });
         let released = s.cut().released_count();
-        // A frame of this body (the same shape) with as many tets released shares its cut.
+        // A frame of this body (the same shape: a reset makes a new body) with as many tets
+        // released shares its cut.
         let shared = match previous {
-            Some(p) if Arc::ptr_eq(&p.shape, &self.shape) => {
+            Some(p) if Arc::ptr_eq(&p.shape, shape) => {
                 (p.cut.released_count() == released).then(|| p.cut.clone())
             }
             _ => None,
         };
         BodyView::Cut(CutView {
-            shape: self.shape.clone(),
+            shape: shape.clone(),
             positions: s.positions().to_vec(),
             cut: shared.unwrap_or_else(|| Arc::new(s.cut().clone())),
             von_mises: s.von_mises().to_vec(),
-            pinned: self.pinned.clone(),
             stress_max: stress_scale(s),
         })
     }
@@ -413,7 +413,10 @@ impl SimBody for XpbdBody {
         Some(Substeps {
             now: self.body.solver().params().substeps,
             nominal: self.nominal,
-            fewest: self.fewest,
+            fewest: *self.fewest.get_or_init(|| {
+                let s = self.body.solver();
+                s.fewest_stable_substeps().clamp(1, self.nominal)
+            }),
         })
     }
 

@@ -229,7 +229,7 @@ impl Loop<'_> {
             if cmd.resets > self.resets_seen {
                 self.resets_seen = cmd.resets;
                 live.reset()?;
-                self.publish(live, true);
+                self.publish(live);
             }
             let mut plan = self.pacer.plan(clock.elapsed().as_secs_f64(), dt);
             if cmd.paused || live.stroke_done() {
@@ -262,12 +262,12 @@ impl Loop<'_> {
         for _ in 0..frames {
             let cmd = self.command();
             match live.step(&cmd)? {
-                Stepped::Done => self.publish(live, false),
+                Stepped::Done => self.publish(live),
                 Stepped::Failed(e) => {
                     // Rolled back: start the scene again rather than end the session.
                     eprintln!("xr: {e}; resetting the scene");
                     live.reset()?;
-                    self.publish(live, true);
+                    self.publish(live);
                     break;
                 }
             }
@@ -278,9 +278,10 @@ impl Loop<'_> {
         Ok(())
     }
 
-    /// Publish `live`'s frame (`fresh`: a new body, nothing shared with the last).
-    fn publish(&self, live: &LiveSim, fresh: bool) {
-        let previous = (!fresh).then(|| self.link.states.get()).flatten();
+    /// Publish `live`'s frame, sharing what is unchanged with the last one published (a
+    /// reset's new body shares nothing: [`crate::sim_body::SimBody::view`]).
+    fn publish(&self, live: &LiveSim) {
+        let previous = self.link.states.get();
         self.link
             .states
             .put(Published::of(live, previous.as_deref()));

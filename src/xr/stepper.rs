@@ -206,7 +206,7 @@ fn in_frame(
         substeps: live.substeps(),
         ..Advanced::default()
     };
-    let mut fresh = false;
+    let mut reset = false;
     for _ in 0..plan.sim_frames {
         if live.stroke_done() {
             break;
@@ -224,7 +224,7 @@ fn in_frame(
                 hook.on_failure(&live.body, &e)?;
                 live.reset()?;
                 hook.after_reset(&mut live.body)?;
-                fresh = true;
+                reset = true;
                 break;
             }
         }
@@ -233,10 +233,10 @@ fn in_frame(
     if plan.sim_frames > 0 {
         pacer.record(plan, done.sim_ms * 1e-3);
     }
-    let shown = done.sim_frames > 0 || fresh;
+    let shown = done.sim_frames > 0 || reset;
     Ok(Step {
         done,
-        view: shown.then(|| live.view(if fresh { None } else { previous })),
+        view: shown.then(|| live.view(previous)),
         scalpel: live.body.body.scalpel_pose(),
     })
 }
