@@ -105,9 +105,9 @@ pub fn run(opts: &XrOptions) -> Result<String> {
             let dev = session.device().clone();
             let mode = sim_mode::resolve(opts.sim, exercise.is_some(), false)?;
             let live = open_body(opts, &scene, (mode.0, opts.device, &dev), played)?;
-            let tray = tray_for(&live);
-            let plan = plan(opts, &scene, mode, (tray, false), exercise);
-            session::run(&mut session, live, plan)
+            let first = live.view(None);
+            let plan = plan(opts, &scene, mode, (tray_for(&first), false), exercise);
+            session::run(&mut session, (live, first), plan)
         }
     }
 }
@@ -191,10 +191,9 @@ fn open_body(
     Ok(if record { live.recording() } else { live })
 }
 
-/// The tray that holds `live`'s body.
-fn tray_for(live: &LiveSim) -> Tray {
-    let view = live.view(None);
-    let positions = match &view {
+/// The tray that holds the body drawn in `view` (its first frame).
+fn tray_for(view: &BodyView) -> Tray {
+    let positions = match view {
         BodyView::Tets(t) => &t.positions,
         BodyView::Cut(c) => &c.positions,
     };
@@ -245,7 +244,8 @@ fn run_simulated(
     };
     let mode = sim_mode::resolve(opts.sim, exercise.is_some(), !script.realtime)?;
     let live = open_body(opts, scene, (mode.0, device, &dev), played)?;
-    let tray = tray_for(&live);
+    let first = live.view(None);
+    let tray = tray_for(&first);
     let stroke = match &script.right {
         Some(RightTrack::Tool { stroke, .. }) => Some(match stroke {
             crate::scene::ToolStroke::File(f) => incise_scalpel::load_stroke(
@@ -260,7 +260,7 @@ fn run_simulated(
     let mut headset =
         SimulatedHeadset::new(script, stroke, tray, BladeOffset::default(), dev, &opts.out)?;
     let plan = plan(opts, scene, mode, (tray, nominal), exercise);
-    session::run(&mut headset, live, plan)
+    session::run(&mut headset, (live, first), plan)
 }
 
 /// The scalpel a scripted incision is cut with: the body's own (an XPBD scene's), else

@@ -142,11 +142,16 @@ impl FrameHook for ExerciseHook<'_> {
     }
 }
 
-/// Run `live` on `headset` as `plan` says; the session's summary line.
-pub fn run(headset: &mut dyn Headset, live: LiveSim, mut plan: SessionPlan) -> Result<String> {
+/// Run `live` on `headset` as `plan` says, drawing `first` (its frame now) until it
+/// steps; the session's summary line.
+pub fn run(
+    headset: &mut dyn Headset,
+    (live, first): (LiveSim, BodyView),
+    mut plan: SessionPlan,
+) -> Result<String> {
     let dev = headset.device().clone();
-    let drawing = BodyDrawing::new(live.view(None))
-        .with_context(|| format!("{}: drawing", plan.scene.display()))?;
+    let drawing =
+        BodyDrawing::new(first).with_context(|| format!("{}: drawing", plan.scene.display()))?;
     let renderer = renderer_for(&dev, headset.format(), &drawing);
     let method = live.body.body.method();
     let script_holds = live.body.body.script_holds_tool();
