@@ -77,6 +77,14 @@ impl XrExercise {
         &self.live.decal
     }
 
+    /// Start an attempt on `body`, the exercise's scene as loaded; pictures of the report
+    /// are taken offscreen.
+    pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
+        self.card_changed |= self.card.take().is_some();
+        let pictures = attempt_pictures(body, &self.live.decal);
+        self.live.start(&mut self.stroke, body, pictures)
+    }
+
     /// After a simulated frame: keep its tool figures and the scalpel's pose (when the
     /// controller is tracked) with whether the trigger engaged it.
     pub fn after_step(
@@ -182,15 +190,5 @@ impl XrExercise {
         };
         let aspect = card.height as f32 / card.width.max(1) as f32;
         Ok(Some(panel_transform(tray, head, aspect)))
-    }
-}
-
-impl XrExercise {
-    /// Start an attempt on `body`, the exercise's scene as loaded; pictures of the report
-    /// are taken offscreen.
-    pub fn start(&mut self, body: &mut RecordedBody) -> Result<()> {
-        self.card_changed |= self.card.take().is_some();
-        let pictures = attempt_pictures(body, &self.live.decal);
-        self.live.start(&mut self.stroke, body, pictures)
     }
 }
