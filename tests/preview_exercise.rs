@@ -1,19 +1,22 @@
 //! An exercise attempt in the preview without a window (issue 10): the preview's attempt
-//! logic runs slab_depth.ron with its reference stroke driving the scalpel, finishes,
-//! scores the live body and saves the attempt; `incise exercise` on the recorded
-//! stroke.ron then gives the same score, from the same released tets (the CPU solver is
-//! deterministic, and the stroke replays bit for bit).
+//! logic (one for every method: `PreviewHand`, a `RecordedBody`, `PreviewExercise`) runs
+//! an exercise with its reference stroke driving the scalpel, finishes, scores the live
+//! body and saves the attempt; `incise exercise` on the recorded stroke.ron then gives the
+//! same score, from the same released tets (XPBD: the CPU solver is deterministic, and
+//! the stroke replays bit for bit) or the same cut surface (Nakao).
 
 mod common;
 
 use std::path::Path;
 
 use common::{score_stroke, temp_dir};
-use incise::exercise::LiveExercise;
-use incise::pictures::screenshots::{ImageSize, Screenshots, default_camera};
-use incise::preview::hand_tool::HandTool;
-use incise::scene::{ToolDriver, build_scene_driven};
-use incise::sim_body::Body;
+use incise::exercise::live::attempt_pictures;
+use incise::exercise::{Finished, ToolFrame};
+use incise::pictures::screenshots::default_camera;
+use incise::preview::PreviewExercise;
+use incise::preview::hand::PreviewHand;
+use incise::sim_body::recorded::RecordedBody;
+use incise::sim_body::{DeviceChoice, OpenOptions};
 use serde_json::Value;
 
 const EXERCISE: &str = "config/exercises/slab_depth.ron";
@@ -22,49 +25,71 @@ fn json(path: &Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+/// The exercise's scene as the preview opens it (on the CPU), and the mouse's hand on it.
+fn preview_body(mode: &PreviewExercise) -> (RecordedBody, PreviewHand) {
+    let opts = OpenOptions {
+        device: DeviceChoice::Cpu,
+        hand: true,
+        script_until_taken: true,
+        quiet: true,
+        ..OpenOptions::default()
+    };
+    let body = RecordedBody::open_with(mode.scene_path(), &opts).unwrap();
+    let mesh = mode.exercise.mesh.clone();
+    let tool = match body.body.solver_parts().and_then(|p| p.tool) {
+        Some(t) => t.clone(),
+        None => incise::scene::hand_tool::default_tool().unwrap(),
+    };
+    let hand = PreviewHand::new(tool, &body, mesh.rest_bounds(), default_camera(&mesh).yaw);
+    (body, hand)
+}
+
+/// "Watch the reference" for `frames` frames, then Finish: the attempt as the preview
+/// makes it, and whether its report has pictures.
+fn reference_attempt(
+    mode: &mut PreviewExercise,
+    frames: impl Fn(f64, f64) -> u64,
+    (out_root, history): (&Path, &Path),
+) -> (Finished, RecordedBody, bool) {
+    let (mut body, mut hand) = preview_body(mode);
+    let reference = mode.reference().unwrap();
+    let frames = frames(reference.end_time(), body.body.frame_dt());
+    hand.play(reference);
+    // Pictures for the report when an offscreen renderer exists (lavapipe will do).
+    let pictures = attempt_pictures(&body, &mode.decal);
+    let rendered = pictures.is_ok();
+    mode.start(&mut hand, &mut body, pictures).unwrap();
+    assert_eq!(mode.running(), Some(0));
+    assert!(!mode.touched());
+    for _ in 0..frames {
+        let tool = hand.tool_input(&body).unwrap();
+        body.step(&tool).unwrap();
+        hand.after_step(&body);
+        mode.after_step(ToolFrame::of(body.last_frame().unwrap()));
+    }
+    assert!(mode.touched(), "the blade never touched the tissue");
+    assert_eq!(mode.running(), Some(frames as usize));
+    let done = mode.finish(&mut hand, &body, out_root, history).unwrap();
+    assert_eq!(mode.running(), None);
+    // A second finish has nothing to finish.
+    assert!(mode.finish(&mut hand, &body, out_root, history).is_err());
+    (done, body, rendered)
+}
+
 #[test]
 fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
     let dir = temp_dir("preview-exercise");
     let history = dir.join("history.jsonl");
-    let mut mode = LiveExercise::open(Path::new(EXERCISE)).unwrap();
-    let scene = incise::scene::load_scene(mode.scene_path()).unwrap();
-    let mut built = build_scene_driven(&scene, mode.scene_path(), None, ToolDriver::Hand).unwrap();
-    let camera = default_camera(built.solver.mesh());
-    let mut hand = HandTool::for_scene(&mut built, camera.yaw).unwrap();
-    // Pictures for the report when an offscreen renderer exists (lavapipe will do).
-    let pictures = Screenshots::new(
-        None,
-        &built.solver,
-        &built.skin,
-        ImageSize(480, 270),
-        Default::default(),
-    )
-    .map(|s| s.with_tool(&hand.tool).with_decal(mode.decal.clone()))
-    .map_err(|e| format!("{e:#}"));
-    let rendered = pictures.is_ok();
-    let mut body = Body::Cpu(Box::new(built.solver));
-    let dt = body.solver().params().frame_dt as f64;
-
-    // The exercise's reference stroke moves the blade, as "Watch the reference" does.
-    let reference = mode.reference().unwrap();
-    let frames = ((reference.end_time() + 0.2) / dt).ceil() as u64;
-    hand.play(reference);
-    mode.start(&mut hand, &mut body, pictures).unwrap();
-    assert_eq!(mode.running(), Some(0));
-    for _ in 0..frames {
-        hand.before_step(&mut body).unwrap();
-        let stats = body.step_frame().unwrap();
-        hand.after_step(&stats);
-        mode.after_step(incise::exercise::ToolFrame::of_xpbd(&stats));
-    }
-    assert_eq!(mode.running(), Some(frames as usize));
-    let live_released: Vec<u64> = (0..body.solver().mesh().tet_count())
-        .filter(|&t| !body.solver().cut().is_live(t))
+    let out_root = dir.join("out/exercises");
+    let mut mode = PreviewExercise::open(Path::new(EXERCISE)).unwrap();
+    let until = |end: f64, dt: f64| ((end + 0.2) / dt).ceil() as u64;
+    let (done, body, rendered) = reference_attempt(&mut mode, until, (&out_root, &history));
+    let frames = body.frames() as u64;
+    let solver = body.body.solver_parts().unwrap().body.solver();
+    let live_released: Vec<u64> = (0..solver.mesh().tet_count())
+        .filter(|&t| !solver.cut().is_live(t))
         .map(|t| t as u64)
         .collect();
-    let out_root = dir.join("out/exercises");
-    let done = mode.finish(&mut hand, &body, &out_root, &history).unwrap();
-    assert_eq!(mode.running(), None);
     assert!(done.dir.starts_with(&out_root));
     assert!(
         done.dir
@@ -75,8 +100,6 @@ fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
         "{}",
         done.dir.display()
     );
-    // A second finish has nothing to finish.
-    assert!(mode.finish(&mut hand, &body, &out_root, &history).is_err());
 
     // result.json parses and is the attempt's; the history gained one line; the card.
     let live = json(&done.attempt.result_path);
@@ -144,39 +167,19 @@ fn a_preview_attempt_scores_as_incise_exercise_does_on_its_stroke() {
     );
 }
 
-/// The method window's attempt on the Nakao plate exercise, without a window: the
-/// reference stroke moves the mouse blade (engaged), the attempt records its pose each
-/// frame and is scored on the body's cut surface; `incise exercise` on the recorded
-/// stroke.ron cuts the same surface and gives the same score.
+/// The preview's attempt on the Nakao plate exercise, without a window: the reference
+/// stroke moves the blade (engaged), the attempt records its pose each frame and is
+/// scored on the body's cut surface; `incise exercise` on the recorded stroke.ron cuts
+/// the same surface and gives the same score.
 #[test]
-fn a_method_window_attempt_on_a_nakao_exercise_scores_as_incise_exercise_does() {
-    use incise::preview::method_exercise::MethodExercise;
-    use incise::sim_body::ToolInput;
-    use incise::sim_body::recorded::RecordedBody;
+fn a_preview_attempt_on_a_nakao_exercise_scores_as_incise_exercise_does() {
     const NAKAO: &str = "config/exercises/plate_line_nakao.ron";
     let dir = temp_dir("preview-exercise-nakao");
     let history = dir.join("history.jsonl");
-    let mut mode = MethodExercise::open(Path::new(NAKAO)).unwrap();
-    let mut body = RecordedBody::open(mode.live.scene_path()).unwrap();
-    let reference = mode.live.reference().unwrap();
-    let dt = body.body.frame_dt();
-    let frames = (reference.end_time() / dt).ceil() as u64;
-    mode.start(&mut body).unwrap();
-    assert!(!mode.live.touched());
-    for f in 1..=frames {
-        let pose = reference.pose_at(f as f64 * dt);
-        body.step(&ToolInput::Hand {
-            pose,
-            engaged: true,
-        })
-        .unwrap();
-        mode.after_step(&body, pose, true).unwrap();
-    }
-    assert!(mode.live.touched(), "the blade never touched the plate");
-    assert_eq!(mode.live.running(), Some(frames as usize));
-    let done = mode
-        .finish(&body, &dir.join("out/exercises"), &history)
-        .unwrap();
+    let mut mode = PreviewExercise::open(Path::new(NAKAO)).unwrap();
+    let until = |end: f64, dt: f64| (end / dt).ceil() as u64;
+    let out_root = dir.join("out/exercises");
+    let (done, _, _) = reference_attempt(&mut mode, until, (&out_root, &history));
     let live = json(&done.attempt.result_path);
     assert_eq!(
         (live["method"].as_str(), live["verdict"]["passed"].as_bool()),

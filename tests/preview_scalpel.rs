@@ -9,17 +9,17 @@ mod common;
 use common::{incise, temp_dir, text};
 use glam::{Vec2, Vec3};
 use incise::pictures::screenshots::default_camera;
-use incise::preview::hand_tool::HandTool;
+use incise::preview::hand::PreviewHand;
 use incise::preview::pick::pick_tissue;
-use incise::scene::{ToolDriver, build_scene_driven, load_scene};
-use incise::sim_body::Body;
+use incise::sim_body::recorded::RecordedBody;
+use incise::sim_body::{DeviceChoice, OpenOptions, ToolInput};
 use serde_json::Value;
 
-/// Released tets of a body.
-fn released(body: &Body) -> Vec<u64> {
-    let cut = body.solver().cut();
-    (0..body.solver().mesh().tet_count())
-        .filter(|&t| !cut.is_live(t))
+/// Released tets of an XPBD body.
+fn released(body: &RecordedBody) -> Vec<u64> {
+    let s = body.body.solver_parts().unwrap().body.solver();
+    (0..s.mesh().tet_count())
+        .filter(|&t| !s.cut().is_live(t))
         .map(|t| t as u64)
         .collect()
 }
@@ -27,14 +27,24 @@ fn released(body: &Body) -> Vec<u64> {
 #[test]
 fn a_mouse_stroke_cuts_records_and_replays_the_same_tets() {
     let path = std::path::Path::new("config/plate_cut.ron");
-    let scene = load_scene(path).unwrap();
-    let mut built = build_scene_driven(&scene, path, None, ToolDriver::Hand).unwrap();
-    let camera = default_camera(built.solver.mesh());
-    let mut hand = HandTool::for_scene(&mut built, camera.yaw).unwrap();
-    let mut body = Body::Cpu(Box::new(built.solver));
-    let dt = body.solver().params().frame_dt as f64;
+    // The scene as the preview opens it: its stroke moves the blade until the mouse
+    // takes it.
+    let opts = OpenOptions {
+        device: DeviceChoice::Cpu,
+        hand: true,
+        script_until_taken: true,
+        quiet: true,
+        ..OpenOptions::default()
+    };
+    let mut body = RecordedBody::open_with(path, &opts).unwrap();
+    let parts = body.body.solver_parts().unwrap();
+    let mesh = parts.body.solver().mesh().clone();
+    let tool = parts.tool.unwrap().clone();
+    let camera = default_camera(&mesh);
+    let mut hand = PreviewHand::new(tool, &body, mesh.rest_bounds(), camera.yaw);
+    assert_eq!(hand.tool_input(&body).unwrap(), ToolInput::Script);
     // The mouse takes the blade from the scene's scripted stroke, then records.
-    hand.take_mouse(0, dt);
+    hand.take_mouse(&body);
     hand.start_recording(&mut body).unwrap();
 
     // The window: 1280 × 720 through the preview's default camera.
@@ -42,15 +52,15 @@ fn a_mouse_stroke_cuts_records_and_replays_the_same_tets() {
     let view = camera.view(size.x / size.y);
     let pixel = |p: Vec3| view.project(p, size).unwrap();
     let (a, b) = (Vec3::new(0.02, 0.02, 0.02), Vec3::new(0.05, 0.02, 0.02));
-    let step = |hand: &mut HandTool, body: &mut Body| {
-        hand.before_step(body).unwrap();
-        let stats = body.step_frame().unwrap();
-        hand.after_step(&stats);
+    let step = |hand: &mut PreviewHand, body: &mut RecordedBody| {
+        let tool = hand.tool_input(body).unwrap();
+        body.step(&tool).unwrap();
+        hand.after_step(body);
     };
     // Cursor over a, left button down: the ray picks the slab's top there.
     let (o, d) = view.ray(pixel(a), size);
     hand.input.cursor(o, d);
-    let s = body.solver();
+    let s = body.body.solver_parts().unwrap().body.solver();
     let hit = pick_tissue(o, d, s.mesh(), s.cut(), s.positions()).expect("tissue under a");
     assert!((hit - a).length() < 1e-4, "picked {hit}");
     assert!(hand.input.press(Some(hit)));
@@ -73,7 +83,7 @@ fn a_mouse_stroke_cuts_records_and_replays_the_same_tets() {
     for _ in 0..10 {
         step(&mut hand, &mut body);
     }
-    let frames = body.solver().frame();
+    let frames = body.frames();
     assert_eq!(frames, 90);
     assert!(
         peak_force > 0.01,

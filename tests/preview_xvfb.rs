@@ -266,10 +266,10 @@ fn the_nakao_preview_draws_the_scripted_blade() {
     );
 }
 
-/// A Nakao exercise opens in the method window with its plan drawn on the plate (the
+/// A Nakao exercise opens in the preview with its plan drawn on the plate (the
 /// panel offers its attempts): the same violet line as an XPBD exercise's.
 #[test]
-fn a_nakao_exercise_draws_its_plan_in_the_method_window() {
+fn a_nakao_exercise_draws_its_plan_in_the_preview() {
     let Some(img) = exercise_window(
         "xvfb-exercise-nakao",
         "config/exercises/plate_line_nakao.ron",
@@ -428,26 +428,27 @@ fn saved(dir: &std::path::Path, stem: &str, ext: &str) -> Vec<std::path::PathBuf
         .collect()
 }
 
-/// The method window's panel (clicked with xdotool at its buttons' places in the 900 ×
-/// 600 window) saves a `.vtu` and a screenshot, turns the heat map off and resets the
-/// Nakao plate to the scene as loaded.
+/// The panel on a Nakao body (clicked with xdotool at its buttons' places in the 900 ×
+/// 600 window: the same panel as an XPBD body's, without the XPBD settings) saves a
+/// `.vtu` and a screenshot, turns the heat map off and resets the plate to the scene as
+/// loaded.
 #[test]
-fn the_method_window_panel_saves_toggles_the_heat_map_and_resets() {
+fn the_panel_saves_toggles_the_heat_map_and_resets_a_nakao_body() {
     let dir = temp_dir("xvfb-method-panel");
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut_nakao.ron");
     let last = dir.join("last.png");
-    // Save .vtu (188, 184), Screenshot (105, 184), the heat map box (15, 161), Reset
-    // (32, 184), then Escape at once (the fresh body a few frames old).
+    // Save .vtu (132, 82), Screenshot (48, 82), the heat map box (15, 468), Reset
+    // (141, 59), then Escape at once (the fresh body a few frames old).
     let script = format!(
         r#"timeout 120 {bin} preview {scene} --frames 100000 --size 900x600 --screenshot {last} &
 P=$!
 W=$(xdotool search --sync --name "incise preview")
 sleep 3
 click() {{ xdotool mousemove --window $W $1 $2; sleep 0.3; xdotool click 1; sleep 1; }}
-click 188 184
-click 105 184
-click 15 161
-click 32 184
+click 132 82
+click 48 82
+click 15 468
+click 141 59
 xdotool windowfocus $W
 xdotool key Escape
 wait $P"#,

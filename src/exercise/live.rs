@@ -3,9 +3,9 @@
 //! recorded (by a [`StrokeSource`]: the preview's mouse blade, the right controller) and
 //! every frame's statistics kept, finished by scoring the live body with the same
 //! [`score_attempt`] as `incise exercise` and saving result.json, report.html, the stroke
-//! and the result card. No window needed: tests drive it with a source and a body: an
-//! XPBD [`Body`] (the preview's and headset's XPBD sessions) or any method's
-//! [`RecordedBody`] (the method window: a Nakao cut surface is scored).
+//! and the result card. No window needed: tests drive it with a source and any method's
+//! [`RecordedBody`] (an XPBD body is scored on its released tets, a Nakao body on its cut
+//! surface).
 
 use std::path::{Path, PathBuf};
 
@@ -18,9 +18,9 @@ use super::{
 };
 use crate::pictures::plan_decal::PlanDecal;
 use crate::pictures::run_pictures::RunPictures;
-use crate::pictures::screenshots::{ImageSize, Screenshots};
+use crate::pictures::screenshots::ImageSize;
+use crate::sim_body::RestCut;
 use crate::sim_body::recorded::RecordedBody;
-use crate::sim_body::{Body, RestCut};
 
 /// Size of the before/after pictures in a live attempt's report, pixels.
 pub const ATTEMPT_PICTURE: ImageSize = ImageSize(960, 540);
@@ -34,8 +34,8 @@ pub fn attempt_pictures(body: &RecordedBody, decal: &PlanDecal) -> Result<RunPic
 }
 
 /// Where a live attempt's scalpel path is recorded on a body `B`: the preview's hand
-/// tool, the XR mode's controller, the method window's mouse blade.
-pub trait StrokeSource<B: ?Sized = Body> {
+/// hand, the XR mode's controller.
+pub trait StrokeSource<B: ?Sized> {
     /// Start recording on `body`, which is at frame 0.
     fn start_recording(&mut self, body: &mut B) -> Result<()>;
     /// Whether a recording is running.
@@ -61,25 +61,6 @@ pub trait AttemptBody {
     fn picture(&self, pictures: &mut Self::Pictures) -> Result<RgbaImage>;
     /// Frames stepped since the scene was loaded.
     fn frame(&self) -> u64;
-}
-
-impl AttemptBody for Body {
-    type Pictures = Screenshots;
-    fn scene_tets(&self) -> Option<usize> {
-        Some(self.solver().mesh().tet_count())
-    }
-    fn rest_cut(&self) -> Result<RestCut> {
-        Ok(RestCut::released_of(self.solver()))
-    }
-    fn device(&self) -> String {
-        Body::device(self)
-    }
-    fn picture(&self, pictures: &mut Screenshots) -> Result<RgbaImage> {
-        pictures.image(self)
-    }
-    fn frame(&self) -> u64 {
-        self.solver().frame()
-    }
 }
 
 impl AttemptBody for RecordedBody {
@@ -108,7 +89,7 @@ impl AttemptBody for RecordedBody {
 }
 
 /// An exercise open on a live body, its report's pictures taken by `P`.
-pub struct LiveExercise<P = Screenshots> {
+pub struct LiveExercise<P> {
     /// The exercise, its scene and plan.
     pub exercise: LoadedExercise,
     /// The plan as a line on the tissue.

@@ -1,6 +1,6 @@
 //! The blade's path during a live attempt, recorded one pose per simulated frame at the
 //! frame's end from the scene as loaded, so that `incise exercise --stroke` replays it:
-//! the headset's controller, the method window's mouse blade.
+//! the headset's controller.
 
 use std::path::Path;
 

@@ -10,7 +10,8 @@ use incise_sim::skin::Skin;
 use incise_xr::BodyState;
 
 use super::tet_drawing::TetDrawing;
-use crate::sim_body::{BodyView, CutView};
+use crate::sim_body::xpbd::VON_MISES;
+use crate::sim_body::{BodyView, CutView, Quantity};
 
 /// The drawing of a body's latest [`BodyView`].
 pub enum BodyDrawing {
@@ -74,6 +75,14 @@ impl BodyDrawing {
                 heat: &c.von_mises,
                 pinned: &c.shape.pinned,
             },
+        }
+    }
+
+    /// What the heat map shows.
+    pub fn quantity(&self) -> Option<Quantity> {
+        match self {
+            BodyDrawing::Tets(d) => d.quantity(),
+            BodyDrawing::Cut(_) => Some(VON_MISES),
         }
     }
 

@@ -1,5 +1,6 @@
-//! The egui side panel: scene picker, play/pause/step/reset, live material and solver
-//! settings, device, overlays with the stress legend, the frame-time graph, the scalpel
+//! The egui side panel, for a body of any method: scene picker, play/pause/step/reset,
+//! the method's figures, its live settings where it has them (the XPBD material and
+//! solver, device), overlays with the heat map's legend, the frame-time graph, the scalpel
 //! (depth, force, haptic amplitude, stroke recording), the exercise (its task, attempts,
 //! the result card in a "Result" window), and buttons for screenshots and `.vtu`
 //! snapshots. It only reports what the user asked for.
@@ -12,8 +13,7 @@ use incise_xr::Overlays;
 use incise_xr::colour_map::turbo;
 
 use super::frame_times::FrameTimes;
-use super::session::LiveParams;
-use crate::sim_body::DeviceChoice;
+use crate::sim_body::{DeviceChoice, Quantity, Tunables};
 
 /// What the user asked for this frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,7 +25,7 @@ pub enum Action {
     /// Start the scene over.
     Reset,
     /// Apply changed settings or device to the running body.
-    Apply(LiveParams, DeviceChoice),
+    Apply(Tunables, DeviceChoice),
     /// Put the camera back to its start.
     ResetView,
     /// Save a screenshot of the window.
@@ -34,7 +34,7 @@ pub enum Action {
     SaveVtu,
     /// Set the scalpel's cut depth, m.
     SetDepth(f32),
-    /// Let the scene's stroke move the scalpel (true) or the mouse (false).
+    /// Let the scene's script move the tool (true) or the mouse (false).
     PlayStroke(bool),
     /// Reload the scene and record the scalpel's poses from frame 0.
     StartRecording,
@@ -58,8 +58,8 @@ pub struct Panel {
     pub scenes: Vec<PathBuf>,
     /// Whether the simulation runs.
     pub playing: bool,
-    /// Settings as edited.
-    pub draft: LiveParams,
+    /// Settings as edited (`None`: the body's method has none to change).
+    pub draft: Option<Tunables>,
     /// Device as chosen.
     pub device: DeviceChoice,
     /// Overlays shown.
@@ -110,13 +110,14 @@ pub struct ScalpelInfo {
     pub amplitude: f32,
     /// Poses recorded so far, when recording.
     pub recording: Option<usize>,
-    /// Whether the scene has a stroke, and whether it is playing.
+    /// Whether the scene has a script that moves its tool, and whether something other
+    /// than the mouse moves it now (the script, or a played stroke).
     pub stroke: (bool, bool),
 }
 
 impl ScalpelInfo {
-    /// The state of `hand`.
-    pub fn of(hand: &super::hand_tool::HandTool) -> Self {
+    /// The state of `hand` on a body whose script can move the tool (`script`).
+    pub fn of(hand: &super::hand::PreviewHand, script: bool) -> Self {
         ScalpelInfo {
             name: hand.tool.name().to_string(),
             cutting: hand.input.cutting(),
@@ -125,7 +126,7 @@ impl ScalpelInfo {
             force: hand.force,
             amplitude: hand.amplitude,
             recording: hand.recording(),
-            stroke: (hand.has_stroke(), hand.play_stroke),
+            stroke: (script, hand.holder() != super::hand::Holder::Mouse),
         }
     }
 }
@@ -134,14 +135,18 @@ impl ScalpelInfo {
 pub struct PanelInfo<'a> {
     /// Scene file in use.
     pub scene: &'a std::path::Path,
+    /// The body's method.
+    pub method: &'a str,
     /// Simulation frame.
     pub frame: u64,
-    /// Released tets.
-    pub released: usize,
-    /// Largest von Mises stress now, Pa.
-    pub max_stress: f32,
-    /// Top of the heat-map scale, Pa.
-    pub stress_max: f32,
+    /// The method's figures of the last frame (released tets and stress, cut counts…).
+    pub status: String,
+    /// A mass-spring body's localisation in the last frame.
+    pub live_lines: Vec<String>,
+    /// What the heat map shows.
+    pub quantity: Option<Quantity>,
+    /// Top of the heat-map scale, in the quantity's unit.
+    pub heat_max: f32,
     /// "cpu" or the GPU adapter.
     pub device: String,
     /// Recent timings.
@@ -166,25 +171,12 @@ impl Panel {
                     self.exercise_section(ui, info.exercise.as_ref(), &mut actions);
                     ui.separator();
                     self.settings_section(ui, &mut actions);
-                    ui.separator();
                     let attempt = info.exercise.as_ref().is_some_and(|e| e.running.is_some());
                     self.scalpel_section(ui, &info.scalpel, attempt, &mut actions);
                     ui.separator();
                     self.overlay_section(ui, info);
                     ui.separator();
                     timing_section(ui, info);
-                    ui.separator();
-                    ui.horizontal(|ui| {
-                        if ui.button("Screenshot").clicked() {
-                            actions.push(Action::Screenshot);
-                        }
-                        if ui.button("Save .vtu").clicked() {
-                            actions.push(Action::SaveVtu);
-                        }
-                        if ui.button("Reset view").clicked() {
-                            actions.push(Action::ResetView);
-                        }
-                    });
                     if !self.message.is_empty() {
                         ui.separator();
                         ui.label(&self.message);
@@ -302,15 +294,32 @@ impl Panel {
                 actions.push(Action::Reset);
             }
         });
-        ui.label(format!(
-            "frame {} · {} tets released · max σvM {:.0} Pa",
-            info.frame, info.released, info.max_stress
-        ));
+        ui.horizontal(|ui| {
+            if ui.button("Screenshot").clicked() {
+                actions.push(Action::Screenshot);
+            }
+            if ui.button("Save .vtu").clicked() {
+                actions.push(Action::SaveVtu);
+            }
+            if ui.button("Reset view").clicked() {
+                actions.push(Action::ResetView);
+            }
+        });
+        ui.label(format!("{} body · frame {}", info.method, info.frame));
+        if !info.status.is_empty() {
+            ui.label(&info.status);
+        }
+        for line in &info.live_lines {
+            ui.small(line);
+        }
     }
 
+    /// The method's live settings, where it has them.
     fn settings_section(&mut self, ui: &mut egui::Ui, actions: &mut Vec<Action>) {
+        let Some(d) = &mut self.draft else {
+            return;
+        };
         ui.heading("Material and solver");
-        let d = &mut self.draft;
         let slider = |ui: &mut egui::Ui, s: egui::Slider<'_>| {
             let r = ui.add(s);
             r.drag_stopped() || (r.changed() && !r.dragged())
@@ -372,8 +381,9 @@ impl Panel {
             }
         });
         if done {
-            actions.push(Action::Apply(self.draft, self.device));
+            actions.push(Action::Apply(*d, self.device));
         }
+        ui.separator();
     }
 
     /// `attempt`: an exercise attempt is under way (it owns the recording).
@@ -386,7 +396,7 @@ impl Panel {
     ) {
         ui.heading("Scalpel");
         let state = match (s.stroke.1, s.cutting, s.parked) {
-            (true, ..) => "a stroke moves it (the scene's, or the exercise's reference)",
+            (true, ..) => "the scene's script or a stroke moves it",
             (_, true, _) => "cutting",
             (_, _, true) => "parked: move the cursor over the tissue",
             _ => "lifted",
@@ -400,7 +410,10 @@ impl Panel {
         }
         if s.stroke.0 {
             let mut play = s.stroke.1;
-            if ui.checkbox(&mut play, "play the scene's stroke").changed() {
+            if ui
+                .checkbox(&mut play, "the scene's script moves it")
+                .changed()
+            {
                 actions.push(Action::PlayStroke(play));
             }
         }
@@ -437,9 +450,10 @@ impl Panel {
     fn overlay_section(&mut self, ui: &mut egui::Ui, info: &PanelInfo<'_>) {
         ui.heading("Overlays");
         let o = &mut self.overlays;
-        ui.checkbox(&mut o.stress, "von Mises heat map");
+        let q = info.quantity.map_or(("heat map", ""), |q| (q.name, q.unit));
+        ui.checkbox(&mut o.stress, format!("heat map: {}", q.0));
         if o.stress {
-            legend(ui, info.stress_max);
+            legend(ui, info.heat_max, q.1);
         }
         ui.checkbox(&mut o.wireframe, "tet wireframe");
         ui.checkbox(&mut o.tool_spheres, "tool contact spheres");
@@ -454,8 +468,8 @@ fn file_name(p: &std::path::Path) -> String {
     )
 }
 
-/// The heat map's colour bar from 0 to `max` Pa.
-fn legend(ui: &mut egui::Ui, max: f32) {
+/// The heat map's colour bar from 0 to `max` (in `unit`).
+fn legend(ui: &mut egui::Ui, max: f32, unit: &str) {
     let (rect, _) = ui.allocate_exact_size(
         Vec2::new(ui.available_width().min(240.0), 14.0),
         egui::Sense::hover(),
@@ -476,9 +490,9 @@ fn legend(ui: &mut egui::Ui, max: f32) {
         );
     }
     ui.horizontal(|ui| {
-        ui.small("0 Pa");
+        ui.small(format!("0 {unit}"));
         ui.add_space(ui.available_width() - 90.0);
-        ui.small(format!("{max:.3e} Pa"));
+        ui.small(format!("{max:.3e} {unit}"));
     });
 }
 

@@ -1,8 +1,8 @@
 //! The preview's window driver, one for every kind of content: the winit event loop, the
 //! window with its GPU surface, egui and the orbit camera ([`WindowShell`]), and the
 //! routing of events — camera drags, wheel and keys to the camera, the left button, the
-//! cursor and the frame to the content ([`WindowContent`]: the XPBD session with its
-//! solver panel, or a body of any method).
+//! cursor and the frame to the content ([`WindowContent`]: [`super::live::Live`], a
+//! body of any method with its panel).
 
 use std::path::Path;
 use std::sync::Arc;

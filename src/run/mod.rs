@@ -63,6 +63,7 @@ fn open_options(opts: &RunOptions) -> Result<OpenOptions> {
         haptic_rate: opts.haptic_rate,
         quiet: opts.quiet,
         hand: false,
+        script_until_taken: false,
         gpu: None,
         free_nodes,
     })

@@ -8,7 +8,8 @@ use std::path::Path;
 use super::body_view::{BodyView, CutView, Quantity, Substeps, TetView};
 use super::outcome::Outcome;
 use super::rest_cut::RestCut;
-use super::xpbd_device::Body;
+use super::tunables::Tunables;
+use super::xpbd_device::{Body, DeviceChoice};
 use crate::report::{FrameData, Report};
 use crate::scene::Method;
 use glam::Vec3;
@@ -100,6 +101,9 @@ pub struct OpenOptions {
     /// stroke is not played; its scalpel (the scene's, else the built-in one) waits above
     /// the organ, dulled, until the hand takes it (XPBD).
     pub hand: bool,
+    /// With `hand`: the scene's stroke still moves the tool until the hand takes it (the
+    /// preview's mouse), as a Nakao blade's or a rheology indenter's script does (XPBD).
+    pub script_until_taken: bool,
 }
 
 /// A simulated body of one method, stepped frame by frame.
@@ -203,6 +207,26 @@ pub trait SimBody: Send {
             "a {} body has no substeps to set to {n}",
             self.method().name()
         )
+    }
+
+    /// Put the tool where a hand takes it, `pose`, at the current frame without stepping
+    /// (`engaged`: cutting, else held dulled), so that the next frame's motion starts
+    /// there, as a recorded stroke's first pose does in its replay (XPBD; other methods
+    /// take the hand's pose each frame and need nothing).
+    fn hold_tool(&mut self, _pose: ToolPose, _engaged: bool) -> anyhow::Result<()> {
+        Ok(())
+    }
+
+    /// The settings a user may change while the body runs (`None`: the method has none).
+    fn tunables(&self) -> Option<Tunables> {
+        None
+    }
+
+    /// Run with `settings` from now on, on `device`, continuing the motion, cut and
+    /// grabs; refused settings (unstable, out of range) leave the body as it was.
+    fn retune(&mut self, settings: Tunables, device: DeviceChoice) -> anyhow::Result<()> {
+        let _ = (settings, device);
+        anyhow::bail!("a {} body has no settings to change", self.method().name())
     }
 
     /// Whether the body's own script moves its tool on [`ToolInput::Script`] (a Nakao

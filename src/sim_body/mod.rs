@@ -17,6 +17,7 @@ pub mod recorded;
 pub mod rest_cut;
 pub mod rheology;
 pub mod rheology_open;
+pub mod tunables;
 pub mod vertex_field;
 pub mod xpbd;
 pub mod xpbd_device;
@@ -26,4 +27,5 @@ pub use interface::{Fault, OpenOptions, SimBody, SolverParts, StepError, Surface
 pub use open::open;
 pub use outcome::Outcome;
 pub use rest_cut::{RestCut, RestCutFace};
+pub use tunables::Tunables;
 pub use xpbd_device::{Body, DeviceChoice, auto_device};

@@ -7,7 +7,7 @@ use std::sync::{Arc, OnceLock};
 
 use anyhow::{Result, bail};
 use glam::{Quat, Vec3};
-use incise_sim::contact::ToolPose;
+use incise_sim::contact::{CutZone, ToolPose};
 use incise_sim::gpu::GpuContext;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::skin::Skin;
@@ -18,14 +18,16 @@ use super::body_view::{BodyView, CutShape, CutView, Quantity, Substeps, TetView}
 use super::interface::{Fault, OpenOptions, SimBody, SolverParts, StepError, Surface, ToolInput};
 use super::outcome::{Outcome, StateHash};
 use super::rest_cut::RestCut;
+use super::tunables::Tunables;
 use super::vertex_field::vertex_mean;
 use super::xpbd_device::{Body, DeviceChoice};
 use crate::report::{FrameData, MaterialInfo, MeshInfo, Report, ToolInfo};
 use crate::scene::Method;
+use crate::scene::hand_tool::edge_zone;
 use crate::scene::{BuiltScene, SceneTool, ToolDriver, build_scene_driven};
 
 /// The heat map of an XPBD body: the tets' von Mises stress at their nodes.
-const VON_MISES: Quantity = Quantity {
+pub const VON_MISES: Quantity = Quantity {
     name: "von Mises stress",
     unit: "Pa",
 };
@@ -47,8 +49,8 @@ pub struct XpbdBody {
     /// takes a waiting tool puts it where it holds it at once (no sweep from where it
     /// waited).
     held: bool,
-    /// Whether a hand holds the tool from the start (the scene's stroke is not played).
-    hand: bool,
+    /// The scene's own cut zone (the edge zone of a retune derives from it).
+    scene_zone: CutZone,
     /// The mesh, skin and pins every drawn frame shares, made when a frame is first drawn
     /// (a run that draws none does not copy the mesh).
     shape: OnceLock<Arc<CutShape>>,
@@ -93,7 +95,7 @@ pub fn open(
     if let Some(t) = built.tool.as_mut() {
         match &opts.stroke {
             Some(file) => t.stroke = Some(incise_scalpel::load_stroke(file)?),
-            None if opts.hand => t.stroke = None,
+            None if opts.hand && !opts.script_until_taken => t.stroke = None,
             None => {}
         }
     }
@@ -106,9 +108,14 @@ pub fn open(
         Some(s) => s.pose_at(0.0),
         None => parked(&built.solver),
     });
+    // Dulled while it waits for a hand, or where a recorded stroke starts lifted.
     let waiting = tool.as_ref().is_some_and(|t| t.stroke.is_none());
+    let lifted = tool.as_ref().is_some_and(|t| match &t.stroke {
+        Some(s) => s.lifted_at(0.0),
+        None => true,
+    });
     if let (Some(t), Some(p)) = (&tool, pose) {
-        let contact = match waiting {
+        let contact = match lifted {
             true => t.contact.dulled(),
             false => t.contact.clone(),
         };
@@ -122,7 +129,7 @@ pub fn open(
         material,
         ..
     } = built;
-    let nominal = solver.params().substeps;
+    let (nominal, scene_zone) = (solver.params().substeps, solver.params().cut_zone);
     let body = Body::place_on(solver, opts.device, opts.gpu.as_ref(), |m| {
         choice = Some(m.to_string())
     })?;
@@ -141,9 +148,9 @@ pub fn open(
             skin,
             tool,
             pose,
-            lifted: waiting,
+            lifted,
             held: !waiting,
-            hand: opts.hand,
+            scene_zone,
             shape: OnceLock::new(),
             material,
             nominal,
@@ -439,7 +446,46 @@ impl SimBody for XpbdBody {
     }
 
     fn script_holds_tool(&self) -> bool {
-        !self.hand
+        self.tool.as_ref().is_some_and(|t| t.stroke.is_some())
+    }
+
+    fn hold_tool(&mut self, pose: ToolPose, engaged: bool) -> Result<()> {
+        self.held = false;
+        Ok(self.place_tool(pose, !engaged)?)
+    }
+
+    fn tunables(&self) -> Option<Tunables> {
+        let p = self.body.solver().params();
+        Some(Tunables {
+            youngs_modulus: self.material.youngs_modulus,
+            poisson_ratio: self.material.poisson_ratio,
+            damping: p.damping,
+            cut_threshold: p.release_threshold,
+            cut_zone: p.cut_zone,
+            edge_zone: match self.scene_zone {
+                CutZone::Anywhere => edge_zone(self.body.solver().mesh().mean_edge_length()),
+                own => own,
+            },
+            substeps: p.substeps,
+            poisson_range: p.poisson_range(),
+        })
+    }
+
+    fn retune(&mut self, t: Tunables, device: DeviceChoice) -> Result<()> {
+        let material = Material {
+            youngs_modulus: t.youngs_modulus,
+            poisson_ratio: t.poisson_ratio,
+            ..self.material
+        };
+        let mut params = self.body.solver().params().clone();
+        params.damping = t.damping;
+        params.release_threshold = t.cut_threshold;
+        params.cut_zone = t.cut_zone;
+        params.substeps = t.substeps;
+        let s = self.body.solver().retuned(material, params)?;
+        self.body = Body::place_on(s, device, self.gpu.as_ref(), |_| {})?;
+        self.material = material;
+        Ok(())
     }
 
     fn solver_parts(&self) -> Option<SolverParts<'_>> {
@@ -583,5 +629,98 @@ mod tests {
         let mut b = hand_body("config/bowel_cantilever.ron");
         assert_eq!(b.substeps(), None);
         assert!(b.set_substeps(3).is_err());
+    }
+
+    /// A setting changed during a pull (the preview's slider): the body goes on from
+    /// where the grab had taken the tissue, as the same frames would without the change,
+    /// neither restarting the grab's path nor dropping it.
+    #[test]
+    fn a_setting_changed_mid_pull_keeps_the_grab_going() {
+        let (mut same, mut tuned) = (
+            hand_body("config/plate_stretch.ron"),
+            hand_body("config/plate_stretch.ron"),
+        );
+        for b in [&mut same, &mut tuned] {
+            for _ in 0..20 {
+                b.step(&ToolInput::Script).unwrap();
+            }
+        }
+        let t = tuned.tunables().unwrap();
+        let damped = Tunables {
+            damping: t.damping * 1.001,
+            ..t
+        };
+        tuned.retune(damped, DeviceChoice::Cpu).unwrap();
+        assert_eq!(tuned.tunables().unwrap(), damped);
+        assert_eq!(tuned.body.solver().frame(), 20, "the frame count goes on");
+        for b in [&mut same, &mut tuned] {
+            for _ in 0..20 {
+                b.step(&ToolInput::Script).unwrap();
+            }
+        }
+        let (a, b) = (same.body.solver(), tuned.body.solver());
+        let largest = |d: &mut dyn Iterator<Item = f32>| d.fold(0.0f32, f32::max);
+        let moved = largest(
+            &mut a
+                .positions()
+                .iter()
+                .zip(&a.mesh().rest_positions)
+                .map(|(p, r)| (*p - *r).length()),
+        );
+        let apart = largest(
+            &mut a
+                .positions()
+                .iter()
+                .zip(b.positions())
+                .map(|(p, q)| (*p - *q).length()),
+        );
+        assert!(moved > 1e-3, "the grab pulls the plate: {moved} m");
+        assert!(
+            apart < 0.01 * moved,
+            "a 0.1 % damping change moved the body {apart} m of {moved}"
+        );
+    }
+
+    /// "Only along the blade's edge" on a tearing scene: with the edge zone the grab
+    /// stretches the plate without releasing a tet (the blade waits away from it); with
+    /// the scene's own zone again, the same body tears where the stress passes the
+    /// threshold, as `incise run` does.
+    #[test]
+    fn the_edge_zone_stops_and_restores_tearing() {
+        let mut b = hand_body("config/plate_stretch.ron");
+        let own = b.tunables().unwrap();
+        assert_eq!(own.cut_zone, CutZone::Anywhere, "the scene's own zone");
+        let edge = Tunables {
+            cut_zone: own.edge_zone,
+            ..own
+        };
+        b.retune(edge, DeviceChoice::Cpu).unwrap();
+        assert_eq!(b.body.solver().params().cut_zone, own.edge_zone);
+        for _ in 0..150 {
+            b.step(&ToolInput::Script).unwrap();
+        }
+        let released = |b: &XpbdBody| b.body.solver().cut().released_count();
+        assert_eq!(released(&b), 0, "the edge zone tore the plate");
+        b.retune(own, DeviceChoice::Cpu).unwrap();
+        for _ in 0..5 {
+            b.step(&ToolInput::Script).unwrap();
+        }
+        assert!(
+            released(&b) > 0,
+            "back to its own zone, the stretched plate tears"
+        );
+    }
+
+    /// Unusable settings are refused and leave the body as it was.
+    #[test]
+    fn refused_settings_leave_the_body_as_it_was() {
+        let mut b = hand_plate();
+        let t = b.tunables().unwrap();
+        let broken = Tunables {
+            poisson_ratio: 0.7,
+            ..t
+        };
+        assert!(b.retune(broken, DeviceChoice::Cpu).is_err());
+        assert_eq!(b.tunables().unwrap(), t);
     }
 }
