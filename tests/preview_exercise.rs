@@ -15,8 +15,9 @@ use incise::exercise::{Finished, ToolFrame};
 use incise::pictures::screenshots::default_camera;
 use incise::preview::PreviewExercise;
 use incise::preview::hand::PreviewHand;
+use incise::preview::live::preview_options;
+use incise::sim_body::DeviceChoice;
 use incise::sim_body::recorded::RecordedBody;
-use incise::sim_body::{DeviceChoice, OpenOptions};
 use serde_json::Value;
 
 const EXERCISE: &str = "config/exercises/slab_depth.ron";
@@ -27,13 +28,7 @@ fn json(path: &Path) -> Value {
 
 /// The exercise's scene as the preview opens it (on the CPU), and the mouse's hand on it.
 fn preview_body(mode: &PreviewExercise) -> (RecordedBody, PreviewHand) {
-    let opts = OpenOptions {
-        device: DeviceChoice::Cpu,
-        hand: true,
-        script_until_taken: true,
-        quiet: true,
-        ..OpenOptions::default()
-    };
+    let opts = preview_options(DeviceChoice::Cpu, None);
     let body = RecordedBody::open_with(mode.scene_path(), &opts).unwrap();
     let mesh = mode.exercise.mesh.clone();
     let tool = match body.body.solver_parts().and_then(|p| p.tool) {

@@ -10,9 +10,10 @@ use common::{incise, temp_dir, text};
 use glam::{Vec2, Vec3};
 use incise::pictures::screenshots::default_camera;
 use incise::preview::hand::PreviewHand;
+use incise::preview::live::preview_options;
 use incise::preview::pick::pick_tissue;
 use incise::sim_body::recorded::RecordedBody;
-use incise::sim_body::{DeviceChoice, OpenOptions, ToolInput};
+use incise::sim_body::{DeviceChoice, ToolInput};
 use serde_json::Value;
 
 /// Released tets of an XPBD body.
@@ -29,13 +30,7 @@ fn a_mouse_stroke_cuts_records_and_replays_the_same_tets() {
     let path = std::path::Path::new("config/plate_cut.ron");
     // The scene as the preview opens it: its stroke moves the blade until the mouse
     // takes it.
-    let opts = OpenOptions {
-        device: DeviceChoice::Cpu,
-        hand: true,
-        script_until_taken: true,
-        quiet: true,
-        ..OpenOptions::default()
-    };
+    let opts = preview_options(DeviceChoice::Cpu, None);
     let mut body = RecordedBody::open_with(path, &opts).unwrap();
     let parts = body.body.solver_parts().unwrap();
     let mesh = parts.body.solver().mesh().clone();

@@ -25,6 +25,7 @@ use crate::pictures::body_drawing::BodyDrawing;
 use crate::pictures::tool_view::pose_matrix;
 use crate::sim_body::recorded::RecordedBody;
 use crate::sim_body::{Body, DeviceChoice, OpenOptions};
+use incise_sim::gpu::GpuContext;
 
 /// Everything that exists while the window is open.
 pub struct Live {
@@ -51,21 +52,27 @@ pub struct Live {
     pub(super) exercise: Option<PreviewExercise>,
 }
 
-/// Open the scene at `path` for the window's device `gpu` (the solver on `device`): any
-/// method, the tool the script's until a hand takes it.
+/// How the preview opens a scene's body (any method): the solver on `device`, a GPU one
+/// on `gpu` (the window's device, so the renderer draws its buffers), and the tool the
+/// scene's script's until a hand takes it.
+pub fn preview_options(device: DeviceChoice, gpu: Option<GpuContext>) -> OpenOptions {
+    OpenOptions {
+        device,
+        gpu,
+        hand: true,
+        script_until_taken: true,
+        quiet: true,
+        ..OpenOptions::default()
+    }
+}
+
+/// Open the scene at `path` for the window's device `gpu` (the solver on `device`).
 pub(super) fn open_body(
     path: &Path,
     device: DeviceChoice,
     gpu: &WindowGpu,
 ) -> Result<RecordedBody> {
-    let opts = OpenOptions {
-        device,
-        gpu: Some(gpu.dev.compute_context()),
-        hand: true,
-        script_until_taken: true,
-        quiet: true,
-        ..OpenOptions::default()
-    };
+    let opts = preview_options(device, Some(gpu.dev.compute_context()));
     RecordedBody::open_with(path, &opts)
 }
 
