@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use incise_sim::Material;
 use incise_sim::ron_file::{self, ReadError, SyntaxError};
 
-use super::{MaterialChoice, Scene};
+use super::{MaterialChoice, Method, Scene};
 
 /// Why a scene or material file could not be used.
 #[derive(Debug, thiserror::Error)]
@@ -73,6 +73,18 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
                 ),
             ));
         }
+    }
+    let scheme = scene.solver.scheme;
+    if scheme != incise_sim::implicit::Scheme::Xpbd && scene.model.method() != Method::Xpbd {
+        return Err(value_err(
+            "solver.scheme",
+            format!(
+                "is {}, a scheme of the Xpbd model's tet solver; a {} scene steps its own \
+                 way: remove this field",
+                scheme.name(),
+                scene.model.method().name()
+            ),
+        ));
     }
     match (&scene.model, &scene.material) {
         (super::ModelChoice::Rheology(rh), material) => {
@@ -240,6 +252,29 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("t.ron:5: duration"), "{e}");
+    }
+
+    /// A solver scheme asked of a method that has no tet solver is refused at its line,
+    /// not silently ignored.
+    #[test]
+    fn a_scheme_for_a_method_without_one_is_refused_at_its_line() {
+        let nakao = GOOD.replace(
+            "duration: 1.0,",
+            "duration: 1.0,\n        model: MassSpring(()),\n        solver: (scheme: Newton(())),",
+        );
+        let e = parse_scene(&nakao, Path::new("t.ron"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.ron:7: solver.scheme"), "{e}");
+        assert!(
+            e.contains("Newton") && e.contains("remove this field"),
+            "{e}"
+        );
+        let xpbd = GOOD.replace(
+            "duration: 1.0,",
+            "duration: 1.0,\n        solver: (scheme: Newton(())),",
+        );
+        assert!(parse_scene(&xpbd, Path::new("t.ron")).is_ok());
     }
 
     #[test]
