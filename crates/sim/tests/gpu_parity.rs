@@ -216,3 +216,58 @@ fn a_frames_passes_are_counted_on_both_solvers() {
         1 + n * (2 + colours) + 3 * checks + stress
     );
 }
+
+/// The partitioned order on the GPU (one dispatch per phase of `xpbd/sweep_plan.rs`, a
+/// workgroup per group, its colours behind barriers) follows the CPU's `Blocks` sweep:
+/// the same released tets frame by frame, positions as close as the coloured order's, and
+/// a sweep of 4 dispatches instead of one per colour, so a frame needs under a quarter of
+/// the coloured order's dispatches (issue 35, item 4).
+#[test]
+fn the_gpu_follows_the_partitioned_order_in_a_quarter_of_the_dispatches() {
+    use incise_sim::xpbd::CpuSweep;
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
+    let blocks = |p: &mut SolverParams| p.cpu_sweep = CpuSweep::Blocks;
+    let mut cpu = common::tearing_bar_with(blocks);
+    let mut gpu = GpuSolver::new(common::tearing_bar_with(blocks), &ctx).expect("upload");
+    let mut coloured = GpuSolver::new(common::tearing_bar(1), &ctx).expect("upload");
+    let size = {
+        let (lo, hi) = cpu.mesh().rest_bounds();
+        (hi - lo).length()
+    };
+    let mut passes = (0, 0);
+    for frame in 0..40 {
+        let a = cpu.step_frame().unwrap();
+        let b = gpu.step_frame().unwrap();
+        passes = (b.passes, coloured.step_frame().unwrap().passes);
+        let worst = worst_gap(cpu.positions(), gpu.host().positions());
+        let tol = if frame < 20 { 1e-4 } else { 1e-2 };
+        assert!(
+            worst < tol * size,
+            "frame {frame}: positions differ by {worst:e} m (mesh size {size} m)"
+        );
+        assert_eq!(a.released_total, b.released_total, "frame {frame}");
+        assert_eq!(
+            cpu.cut().live(),
+            gpu.host().cut().live(),
+            "frame {frame}: released sets differ"
+        );
+    }
+    assert!(
+        cpu.cut().released_count() > 0,
+        "the bar never tore: the test saw no cut"
+    );
+    let colours = cpu.color_count() as u32;
+    assert!(colours > 8, "{colours} colours");
+    eprintln!(
+        "dispatches a frame: {} partitioned, {} coloured",
+        passes.0, passes.1
+    );
+    assert!(
+        4 * passes.0 <= passes.1,
+        "{} dispatches a frame partitioned against {} coloured",
+        passes.0,
+        passes.1
+    );
+}

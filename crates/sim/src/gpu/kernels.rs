@@ -30,6 +30,8 @@ pub fn shader_source(stage: &str) -> Option<String> {
 pub(crate) struct Kernels {
     pub predict: wgpu::ComputePipeline,
     pub project: wgpu::ComputePipeline,
+    /// `neo_hookean.wgsl`'s `project_groups`: one phase of the partitioned order.
+    pub project_groups: wgpu::ComputePipeline,
     pub contact: wgpu::ComputePipeline,
     pub velocity: wgpu::ComputePipeline,
     pub stress: wgpu::ComputePipeline,
@@ -62,6 +64,7 @@ impl Kernels {
         Kernels {
             predict: make("predict"),
             project: make("neo_hookean"),
+            project_groups: make_entry("neo_hookean", "project_groups"),
             contact: make("contact"),
             velocity: make("velocity"),
             stress: make("stress"),

@@ -15,7 +15,7 @@ use crate::Solver;
 use crate::contact::{ContactTool, CutZone, PlacedTool, ToolPose};
 use crate::stress::StressMeasure;
 use crate::xpbd::{
-    ConstraintPair, FrameStats, NodeKind, SolverError, TetProjection, release_checks,
+    ConstraintPair, CpuSweep, FrameStats, NodeKind, SolverError, TetProjection, release_checks,
 };
 
 const WG: u32 = 64;
@@ -38,6 +38,9 @@ struct Buffers {
     kind: wgpu::Buffer,
     grab_offsets: wgpu::Buffer,
     tets: wgpu::Buffer,
+    /// The partitioned order's slot runs per group and colour, and each phase's groups.
+    runs: wgpu::Buffer,
+    phase_groups: wgpu::Buffer,
     rest: wgpu::Buffer,
     live: wgpu::Buffer,
     saved_live: wgpu::Buffer,
@@ -61,6 +64,8 @@ struct Bindings {
     predict_steps: Vec<wgpu::BindGroup>,
     project: wgpu::BindGroup,
     project_steps: Vec<wgpu::BindGroup>,
+    project_groups: wgpu::BindGroup,
+    phase_steps: Vec<wgpu::BindGroup>,
     contact: wgpu::BindGroup,
     contact_steps: Vec<wgpu::BindGroup>,
     velocity: wgpu::BindGroup,
@@ -216,7 +221,8 @@ impl GpuSolver {
         // Step records: one per substep (prediction), then one per colour.
         let substeps = p.substeps as usize;
         let colours = host.color_ranges.len();
-        let mut step_bytes = vec![0u8; (substeps + colours) * STEP_STRIDE as usize];
+        let phases = host.plan.phases.len();
+        let mut step_bytes = vec![0u8; (substeps + colours + phases) * STEP_STRIDE as usize];
         let mut put = |k: usize, s: Step| {
             let o = k * STEP_STRIDE as usize;
             step_bytes[o..o + 16].copy_from_slice(bytemuck::bytes_of(&s));
@@ -243,6 +249,23 @@ impl GpuSolver {
                 },
             );
         }
+        // Then one per phase of the partitioned order: its first group, and the colours.
+        let mut phase_groups: Vec<u32> = Vec::new();
+        for (k, phase) in host.plan.phases.iter().enumerate() {
+            put(
+                substeps + colours + k,
+                Step {
+                    first: phase_groups.len() as u32,
+                    count: colours as u32,
+                    substep: 0,
+                    pad: 0,
+                },
+            );
+            phase_groups.extend(phase.iter().map(|&g| g as u32));
+        }
+        let runs: Vec<[u32; 2]> = (host.plan.runs.iter())
+            .flat_map(|g| g.iter().map(|r| [r.start as u32, r.end as u32]))
+            .collect();
         let none = wgpu::BufferUsages::empty();
         let pos_b = storage(&device, "pos", bytemuck::cast_slice(&pos), none);
         let buf = Buffers {
@@ -280,6 +303,13 @@ impl GpuSolver {
                 none,
             ),
             tets: storage(&device, "tets", bytemuck::cast_slice(&tets), none),
+            runs: storage(&device, "runs", bytemuck::cast_slice(&runs), none),
+            phase_groups: storage(
+                &device,
+                "phase groups",
+                bytemuck::cast_slice(&phase_groups),
+                none,
+            ),
             rest: storage(&device, "rest", bytemuck::cast_slice(&rest), none),
             live: storage(&device, "live", bytemuck::cast_slice(&live), none),
             saved_live: storage(&device, "saved live", bytemuck::cast_slice(&live), none),
@@ -353,6 +383,24 @@ impl GpuSolver {
             ),
             project_steps: (0..colours)
                 .map(|c| step_group(&kernels.project, substeps + c))
+                .collect(),
+            project_groups: group(
+                &kernels.project_groups,
+                0,
+                &[
+                    &b.params,
+                    &b.pos,
+                    &b.tets,
+                    &b.rest,
+                    &b.live,
+                    &b.lambda,
+                    &b.runs,
+                    &b.phase_groups,
+                ],
+                "project groups",
+            ),
+            phase_steps: (0..phases)
+                .map(|k| step_group(&kernels.project_groups, substeps + colours + k))
                 .collect(),
             contact: contact_group(&device, &kernels, b),
             contact_steps: (0..substeps)
@@ -677,13 +725,7 @@ impl GpuSolver {
             pass.set_bind_group(0, &self.bind.predict, &[]);
             pass.set_bind_group(1, &self.bind.predict_steps[s], &[]);
             pass.dispatch_workgroups(groups(n), 1, 1);
-            pass.set_pipeline(&k.project);
-            pass.set_bind_group(0, &self.bind.project, &[]);
-            for (c, r) in self.host.color_ranges.iter().enumerate() {
-                pass.set_bind_group(1, &self.bind.project_steps[c], &[]);
-                pass.dispatch_workgroups(groups(r.len()), 1, 1);
-            }
-            dispatches += 2 + self.host.color_ranges.len() as u32;
+            dispatches += 2 + self.record_sweep(&mut pass);
             if self.host.tool.is_some() {
                 dispatches += 1;
                 pass.set_pipeline(&k.contact);
@@ -704,6 +746,33 @@ impl GpuSolver {
             dispatches += self.record_stress(&mut pass);
         }
         dispatches
+    }
+
+    /// One sweep over the tets in the order the solver's settings choose (the CPU's
+    /// `cpu_sweep`, so that both follow one Gauss–Seidel order): a dispatch per colour, or
+    /// per phase of the partitioned order; returns the dispatch count.
+    fn record_sweep(&self, pass: &mut wgpu::ComputePass<'_>) -> u32 {
+        let k = &self.kernels;
+        match self.host.params.cpu_sweep {
+            CpuSweep::Coloured => {
+                pass.set_pipeline(&k.project);
+                pass.set_bind_group(0, &self.bind.project, &[]);
+                for (c, r) in self.host.color_ranges.iter().enumerate() {
+                    pass.set_bind_group(1, &self.bind.project_steps[c], &[]);
+                    pass.dispatch_workgroups(groups(r.len()), 1, 1);
+                }
+                self.host.color_ranges.len() as u32
+            }
+            CpuSweep::Blocks => {
+                pass.set_pipeline(&k.project_groups);
+                pass.set_bind_group(0, &self.bind.project_groups, &[]);
+                for (p, phase) in self.host.plan.phases.iter().enumerate() {
+                    pass.set_bind_group(1, &self.bind.phase_steps[p], &[]);
+                    pass.dispatch_workgroups(phase.len() as u32, 1, 1);
+                }
+                self.host.plan.phases.len() as u32
+            }
+        }
     }
 
     /// The stress pass; returns its dispatch count (1).

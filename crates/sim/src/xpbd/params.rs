@@ -35,8 +35,10 @@ pub enum CpuSweep {
     #[default]
     Coloured,
     /// The mesh in fixed slabs (`xpbd/sweep_plan.rs`): each slab's tets colour after
-    /// colour by one task, then the tets across slabs; four synchronisations a sweep.
-    /// Another Gauss–Seidel order: the same converged answer, not the same rounding.
+    /// colour by one task, then the tets across slabs; four synchronisations a sweep. The
+    /// GPU follows it with one dispatch per phase (a workgroup per slab or cut) instead of
+    /// one per colour. Another Gauss–Seidel order: the same converged answer, not the same
+    /// rounding.
     Blocks,
 }
 
@@ -75,7 +77,8 @@ pub struct SolverParams {
     /// How the CPU projects the rest-free coupled pair: `Lanes` (default, eight tets at
     /// once in SIMD lanes) or `Scalar` (the readable reference, one tet at a time).
     pub cpu_kernel: CpuKernel,
-    /// The order of a CPU sweep: `Coloured` (default) or `Blocks` (fewer synchronisations).
+    /// The order of a sweep, on the CPU and the GPU alike: `Coloured` (default) or
+    /// `Blocks` (fewer synchronisations and dispatches).
     pub cpu_sweep: CpuSweep,
     /// von Mises stress above which a tet is released, Pa; `None` disables cutting.
     pub release_threshold: Option<f32>,

@@ -1,4 +1,5 @@
-// Neo-Hookean constraint projection of one colour (PHYSICS.md §1.2, Macklin & Müller 2021):
+// Neo-Hookean constraint projection of one colour, or of one phase of the partitioned
+// order (PHYSICS.md §1.2, Macklin & Müller 2021):
 // the rest-free pair C_H = ln J, C_D = sqrt(I_C - 3 - 2 ln J) (P.pair 0, default) or the
 // seed's C_D = ||F||_F, C_H = det F - gamma (P.pair 1); coupled 2x2 solve (default) or H
 // then D. Tets of one colour share no node, so each invocation owns its four nodes.
@@ -12,6 +13,10 @@
 @group(0) @binding(4) var<storage, read> live: array<u32>;
 @group(0) @binding(5) var<storage, read_write> lambda_h: array<f32>;
 @group(1) @binding(0) var<uniform> S: Step;
+// The partitioned order (`project_groups`, crates/sim/src/xpbd/sweep_plan.rs): runs[g *
+// colours + c] = the slots (start, end) of group g and colour c; the groups of each phase.
+@group(0) @binding(6) var<storage, read> runs: array<vec2<u32>>;
+@group(0) @binding(7) var<storage, read> phase_groups: array<u32>;
 
 // PHYSICS.md §1.2, table row C_H: d det F / dF = [f2 x f3, f3 x f1, f1 x f2].
 fn det_gradient(f: mat3x3<f32>) -> mat3x3<f32> {
@@ -203,12 +208,8 @@ fn project_rest_free_sequential(dm_inv: mat3x3<f32>, alpha_h: f32, alpha_d: f32)
     return dl_h;
 }
 
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= S.count) {
-        return;
-    }
-    let slot = S.first + gid.x;
+// Project the tet in `slot`, if it is live.
+fn project_slot(slot: u32) {
     if (live[slot] == 0u) {
         return;
     }
@@ -233,5 +234,35 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     lambda_h[slot] = dl_h;
     for (var i = 0; i < 4; i++) {
         pos[idx[i]] = vec4<f32>(x[i], w[i]);
+    }
+}
+
+// One colour over the whole mesh: S.first, S.count = its slots.
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= S.count) {
+        return;
+    }
+    project_slot(S.first + gid.x);
+}
+
+// One phase of the partitioned order (CPU twin: Solver::project_blocks): one workgroup
+// per group (phase_groups[S.first + workgroup]), its tets colour after colour (S.count
+// colours), the workgroup's invocations splitting each colour's run and meeting at a
+// barrier before the next. The groups of a phase share no node, so a sweep needs one
+// dispatch per phase instead of one per colour.
+@compute @workgroup_size(64)
+fn project_groups(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+) {
+    let g = phase_groups[S.first + wid.x];
+    for (var c = 0u; c < S.count; c++) {
+        let run = runs[g * S.count + c];
+        for (var slot = run.x + li; slot < run.y; slot += 64u) {
+            project_slot(slot);
+        }
+        storageBarrier();
+        workgroupBarrier();
     }
 }
