@@ -723,4 +723,27 @@ mod tests {
         assert!(b.retune(broken, DeviceChoice::Cpu).is_err());
         assert_eq!(b.tunables().unwrap(), t);
     }
+
+    /// A recording's first pose (the preview's): the hand holds the tool there at frame 0
+    /// without a step, so the first frame sweeps it from there, as the replay of the
+    /// recorded stroke does from its first key.
+    #[test]
+    fn a_held_tool_starts_the_next_frame_where_it_was_put() {
+        let mut b = hand_plate();
+        let at = |x: f32| ToolPose {
+            position: Vec3::new(x, 0.02, 0.03),
+            rotation: Quat::IDENTITY,
+        };
+        b.hold_tool(at(0.04), true).unwrap();
+        let m = b.body.solver().tool().unwrap();
+        assert_eq!((m.from, m.to), (at(0.04), at(0.04)));
+        // The next frame's hand pose, engaged as held: the tool moves over the frame.
+        b.place_tool(at(0.045), false).unwrap();
+        let m = b.body.solver().tool().unwrap();
+        assert_eq!(
+            (m.from, m.to),
+            (at(0.04), at(0.045)),
+            "swept from the held pose"
+        );
+    }
 }
