@@ -1,6 +1,7 @@
 //! PNG figures for experiments: line charts of named (x, y) series, and panels of line
-//! segments drawn to scale (mesh side views). Pure Rust: plotters' bitmap backend and PNG
-//! encoder, text through `ab_glyph` with DejaVu Sans embedded (`assets/fonts/`).
+//! segments drawn to scale (mesh side views). Pure Rust: plotters' bitmap backend into a
+//! buffer, saved by incise-xr's PNG writer; text through `ab_glyph` with DejaVu Sans
+//! embedded (`assets/fonts/`).
 
 use std::path::Path;
 use std::sync::Once;

@@ -49,9 +49,10 @@ impl RenderDevice {
     /// Open a device without a window (offscreen rendering, benchmarks, tests). Honours
     /// `WGPU_BACKEND` and friends. Without it, Vulkan is opened without the window-system
     /// extensions first ([`crate::vulkan_instance`]), then the other primary backends
-    /// (Metal, DX12), then GL: asking for Wayland/X11 surfaces (Mesa's device-select layer
-    /// then connects to the display) or starting GL (it probes the window systems) prints
-    /// "error: XDG_RUNTIME_DIR is invalid or not set" on a machine with no display.
+    /// (Metal, DX12), then every backend built in (GL too in a build with the app's `gl`
+    /// feature): asking for Wayland/X11 surfaces (Mesa's device-select layer then connects
+    /// to the display) or starting GL (it probes the window systems) prints "error:
+    /// XDG_RUNTIME_DIR is invalid or not set" on a machine with no display.
     pub fn headless() -> Result<Self, RenderError> {
         let from_env = std::env::var_os("WGPU_BACKEND").is_some();
         if !from_env

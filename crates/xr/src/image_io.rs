@@ -1,6 +1,7 @@
-//! RGBA8 images as the renderer reads them back, and their PNG files.
+//! RGBA8 images as the renderer reads them back, and their PNG files (through the `png`
+//! crate itself: `image` would add its colour-management crates, moxcms and pxfm, to every
+//! build for a format this needs only one of).
 
-use image::ImageEncoder;
 use std::path::Path;
 
 use crate::error::RenderError;
@@ -50,30 +51,58 @@ impl RgbaImage {
             msg,
         };
         let mut png = Vec::new();
-        image::codecs::png::PngEncoder::new(&mut png)
-            .write_image(
-                &self.pixels,
-                self.width,
-                self.height,
-                image::ExtendedColorType::Rgba8,
-            )
+        let mut encoder = png::Encoder::new(&mut png, self.width, self.height);
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        // The compression and filter `image`'s PNG encoder chose.
+        encoder.set_compression(png::Compression::Balanced);
+        encoder.set_filter(png::Filter::Adaptive);
+        let mut writer = encoder.write_header().map_err(|e| err(e.to_string()))?;
+        writer
+            .write_image_data(&self.pixels)
             .map_err(|e| err(e.to_string()))?;
+        writer.finish().map_err(|e| err(e.to_string()))?;
         // Written to a sibling and renamed: a process killed mid-write leaves the old
         // file or none, never half a PNG (issue 11).
         incise_sim::io::write_atomic(path, &png).map_err(|e| err(e.to_string()))
     }
 
-    /// Read a PNG (any colour type, converted to RGBA8).
+    /// Read a PNG (any colour type, converted to RGBA8: palettes and grey expanded, a
+    /// `tRNS` chunk made alpha, 16-bit samples cut to their high byte).
     pub fn load_png(path: &Path) -> Result<Self, RenderError> {
-        let img = image::open(path).map_err(|e| RenderError::Image {
+        let err = |msg: String| RenderError::Image {
             path: path.into(),
-            msg: e.to_string(),
-        })?;
-        let rgba = img.to_rgba8();
+            msg,
+        };
+        let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+        let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+        decoder.set_transformations(png::Transformations::normalize_to_color8());
+        let mut reader = decoder.read_info().map_err(|e| err(e.to_string()))?;
+        let size = reader
+            .output_buffer_size()
+            .ok_or_else(|| err("image too large".into()))?;
+        let mut buf = vec![0; size];
+        let frame = reader
+            .next_frame(&mut buf)
+            .map_err(|e| err(e.to_string()))?;
+        buf.truncate(frame.buffer_size());
+        let pixels = match frame.color_type {
+            png::ColorType::Rgba => buf,
+            png::ColorType::Rgb => buf
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect(),
+            png::ColorType::GrayscaleAlpha => buf
+                .chunks_exact(2)
+                .flat_map(|p| [p[0], p[0], p[0], p[1]])
+                .collect(),
+            png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g, 255]).collect(),
+            png::ColorType::Indexed => return Err(err("palette left unexpanded".into())),
+        };
         Ok(RgbaImage {
-            width: rgba.width(),
-            height: rgba.height(),
-            pixels: rgba.into_raw(),
+            width: frame.width,
+            height: frame.height,
+            pixels,
         })
     }
 }
@@ -91,6 +120,27 @@ mod tests {
         let p = dir.join("a.png");
         img.save_png(&p).unwrap();
         assert_eq!(RgbaImage::load_png(&p).unwrap(), img);
+        // Other colour types come back as RGBA8.
+        for (color, pixel, rgba) in [
+            (png::ColorType::Rgb, &[10u8, 20, 30][..], [10, 20, 30, 255]),
+            (png::ColorType::Grayscale, &[7][..], [7, 7, 7, 255]),
+            (png::ColorType::GrayscaleAlpha, &[7, 9][..], [7, 7, 7, 9]),
+        ] {
+            let mut bytes = Vec::new();
+            let mut encoder = png::Encoder::new(&mut bytes, 1, 1);
+            encoder.set_color(color);
+            encoder.set_depth(png::BitDepth::Eight);
+            let mut writer = encoder.write_header().unwrap();
+            writer.write_image_data(pixel).unwrap();
+            writer.finish().unwrap();
+            let p = dir.join("other.png");
+            std::fs::write(&p, &bytes).unwrap();
+            assert_eq!(
+                RgbaImage::load_png(&p).unwrap(),
+                RgbaImage::filled(1, 1, rgba),
+                "{color:?}"
+            );
+        }
         let err = RgbaImage::load_png(&dir.join("missing.png")).unwrap_err();
         assert!(err.to_string().contains("missing.png"), "{err}");
     }
