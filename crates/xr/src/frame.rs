@@ -1,8 +1,8 @@
 //! What the renderer is given each frame: the body's state and the display settings.
 
 use glam::{Mat4, Vec3};
-use incise_sim::cutting::CutState;
 use incise_sim::TetMesh;
+use incise_sim::cutting::CutState;
 
 /// The simulated body as of the last frame.
 #[derive(Clone, Copy)]

@@ -8,9 +8,9 @@
 
 use ash::vk;
 use glam::{UVec3, Vec3};
+use incise_sim::TetMesh;
 use incise_sim::generate::block;
 use incise_sim::skin::Skin;
-use incise_sim::TetMesh;
 use incise_test_gate::{Need, or_skip};
 use incise_xr::openxr::swapchain::{EYE_FORMAT, wrap_image};
 use incise_xr::openxr::vulkan::{DirectVulkan, create_gpu};
