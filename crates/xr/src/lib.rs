@@ -26,6 +26,7 @@ pub mod renderer;
 mod ribbon;
 mod scene_buffers;
 pub mod shaders;
+pub mod simulated;
 mod targets;
 pub mod tool_mesh;
 pub mod vulkan_instance;
