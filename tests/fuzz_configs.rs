@@ -66,7 +66,7 @@ fn formats() -> [(&'static str, Vec<Vec<u8>>, Parser); 5] {
             incise::exercise::parse_exercise(t, p).is_ok()
         }),
         ("headset", files("config/xr"), |t, p| {
-            incise::xr::script::HeadsetScript::parse(t, p).is_ok()
+            incise_xr::simulated::HeadsetScript::parse(t, p).is_ok()
         }),
     ]
 }

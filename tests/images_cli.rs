@@ -190,7 +190,7 @@ fn simulated_headset_eyes_show_the_tissue_and_its_cut_on_the_cpu_and_the_gpu() {
     };
     // Where the slab and the cut are in each eye.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let parsed = incise::xr::script::HeadsetScript::load(&script).unwrap();
+    let parsed = incise_xr::simulated::HeadsetScript::load(&script).unwrap();
     let scene = incise::scene::load_scene(&root.join(PLATE)).unwrap();
     let built = incise::scene::build_scene(&scene, &root.join(PLATE), None).unwrap();
     let (lo, hi) = built.solver.mesh().rest_bounds();

@@ -10,7 +10,6 @@ use clap::ValueEnum;
 use incise_sim::gpu::GpuSolver;
 use incise_sim::skin::Skin;
 use incise_sim::{Solver, TetMesh};
-use incise_xr::frame::pinned_nodes;
 use incise_xr::{
     BodyState, Camera, OffscreenRenderer, Overlays, RenderDevice, RenderSettings, RgbaImage, View,
 };
@@ -131,7 +130,7 @@ impl Screenshots {
                 stress_max: crate::sim_body::xpbd::stress_scale(solver),
                 ..RenderSettings::default()
             },
-            pinned: pinned_nodes(solver),
+            pinned: solver.pinned_nodes(),
             shared_device: false,
             draw_tool: false,
             decal: None,
@@ -178,10 +177,16 @@ impl Screenshots {
             .iter()
             .map(|d| d.line_uncut(solver.positions(), solver.cut().live()))
             .collect();
-        let mut state = BodyState::of_solver(solver, &self.pinned);
-        if let (Body::Gpu(g), true) = (body, self.shared_device) {
-            state.device_displacements = Some(g.displacement_buffer());
-        }
+        let state = BodyState {
+            positions: solver.positions(),
+            device_displacements: match (body, self.shared_device) {
+                (Body::Gpu(g), true) => Some(g.displacement_buffer()),
+                _ => None,
+            },
+            cut: solver.cut(),
+            heat: solver.von_mises(),
+            pinned: &self.pinned,
+        };
         Ok(self
             .offscreen
             .render_image(&state, &self.settings, &self.view)?)

@@ -21,7 +21,7 @@ pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
     StrokeSpec,
 };
-pub use tool::{IncisionSpec, ToolSpec, ToolStroke, incision};
+pub use tool::ToolSpec;
 
 use glam::{UVec3, Vec3};
 use incise_sim::Material;
@@ -69,7 +69,7 @@ pub struct Scene {
     pub tool: Option<ToolSpec>,
     /// What drives the scalpel: `Some(File("strokes/x.ron"))` or `Some(Incision(...))`.
     #[serde(default)]
-    pub stroke: Option<ToolStroke>,
+    pub stroke: Option<incise_scalpel::ToolStroke>,
 }
 
 /// Where a tet mesh comes from.

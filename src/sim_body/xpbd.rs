@@ -391,7 +391,7 @@ impl SimBody for XpbdBody {
             Arc::new(CutShape {
                 mesh: s.mesh().clone(),
                 skin: self.skin.clone(),
-                pinned: incise_xr::frame::pinned_nodes(s),
+                pinned: s.pinned_nodes(),
             })
         });
         let released = s.cut().released_count();

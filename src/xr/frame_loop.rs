@@ -12,6 +12,7 @@ use glam::Mat4;
 use incise_xr::frame::ToolState;
 use incise_xr::openxr::controls::{ControllerState, commands};
 use incise_xr::openxr::eye::eye_view;
+use incise_xr::openxr::frame_log::{FrameLog, FrameRow};
 use incise_xr::openxr::haptics::{HapticCall, HapticGate, haptic_pulse};
 use incise_xr::openxr::lifecycle::{ExitReason, SessionPhase};
 use incise_xr::openxr::scalpel_pose::{BladeOffset, scalpel_pose};
@@ -20,7 +21,6 @@ use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, XrError};
 use incise_xr::{Overlays, RenderDevice, RenderSettings};
 
 use super::command::{Advanced, ToolCommand};
-use super::frame_log::{FrameLog, FrameRow};
 use super::headset_sim::{HeadsetSim, Picture};
 
 /// `Idle` answers in a row after which the loop gives up (about 10 s of a runtime that

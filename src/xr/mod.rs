@@ -6,17 +6,14 @@
 
 pub mod command;
 pub mod exercise;
-pub mod frame_log;
 pub mod frame_loop;
 pub mod headset_sim;
 pub mod latest;
 pub mod live_sim;
 pub mod pacing;
-pub mod script;
 pub mod session;
 pub mod sim_mode;
 pub mod sim_thread;
-pub mod simulated;
 pub mod stepper;
 pub mod unavailable;
 pub mod xr_report;
@@ -26,19 +23,19 @@ use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 use glam::Vec3;
-use incise_scalpel::Stroke;
+use incise_scalpel::{Stroke, ToolStroke};
 use incise_xr::RenderDevice;
 use incise_xr::openxr::scalpel_pose::BladeOffset;
 use incise_xr::openxr::tray::Tray;
 use incise_xr::openxr::{Headset, XrSession};
+use incise_xr::simulated::SimulatedHeadset;
+use incise_xr::simulated::script::{HeadsetScript, Pacing, RightTrack};
 
 use crate::scene::Method;
 use crate::sim_body::{BodyView, DeviceChoice, OpenOptions};
 use live_sim::{BodyOpener, LiveSim, SimFaults};
-use script::{HeadsetScript, Pacing, RightTrack};
 use session::{HeadsetExercise, SessionPlan};
 use sim_mode::{SimChoice, SimMode};
-use simulated::SimulatedHeadset;
 pub use unavailable::XrUnavailable;
 pub use xr_report::XrReport;
 
@@ -248,10 +245,11 @@ fn run_simulated(
     let tray = tray_for(&first);
     let stroke = match &script.right {
         Some(RightTrack::Tool { stroke, .. }) => Some(match stroke {
-            crate::scene::ToolStroke::File(f) => incise_scalpel::load_stroke(
+            ToolStroke::File(f) => incise_scalpel::load_stroke(
                 &script_path.parent().unwrap_or(Path::new(".")).join(f),
             )?,
-            crate::scene::ToolStroke::Incision(i) => crate::scene::incision(&scalpel_of(&live)?, i)
+            ToolStroke::Incision(i) => i
+                .stroke(&scalpel_of(&live)?)
                 .with_context(|| format!("{}: right.stroke", script_path.display()))?,
         }),
         _ => None,

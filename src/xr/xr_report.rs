@@ -5,11 +5,11 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use incise_xr::openxr::Headset;
+use incise_xr::openxr::frame_log::FrameLog;
 use incise_xr::openxr::lifecycle::ExitReason;
 use serde::Serialize;
 
 use super::exercise::AttemptSummary;
-use super::frame_log::FrameLog;
 use crate::scene::Method;
 
 /// A bounding box: its min and max corners (sim world, m).

@@ -1,9 +1,8 @@
 //! What the renderer is given each frame: the body's state and the display settings.
 
 use glam::{Mat4, Vec3};
+use incise_sim::TetMesh;
 use incise_sim::cutting::CutState;
-use incise_sim::xpbd::NodeKind;
-use incise_sim::{Solver, TetMesh};
 
 /// The simulated body as of the last frame.
 #[derive(Clone, Copy)]
@@ -23,25 +22,11 @@ pub struct BodyState<'a> {
     pub pinned: &'a [u32],
 }
 
-impl<'a> BodyState<'a> {
-    /// The state of `solver` (host positions); `pinned` lists its pinned nodes, see
-    /// [`pinned_nodes`].
-    pub fn of_solver(solver: &'a Solver, pinned: &'a [u32]) -> Self {
-        BodyState {
-            positions: solver.positions(),
-            device_displacements: None,
-            cut: solver.cut(),
-            heat: solver.von_mises(),
-            pinned,
-        }
-    }
-}
-
 /// An uncut, unstressed body of a mesh, nothing pinned: with any node positions it makes
 /// a [`BodyState`] (benchmarks, tests, pictures of a mesh as it is).
 pub struct UncutBody {
     cut: CutState,
-    von_mises: Vec<f32>,
+    heat: Vec<f32>,
 }
 
 impl UncutBody {
@@ -49,7 +34,7 @@ impl UncutBody {
     pub fn new(mesh: &TetMesh) -> Self {
         UncutBody {
             cut: CutState::new(mesh),
-            von_mises: vec![0.0; mesh.tet_count()],
+            heat: vec![0.0; mesh.tet_count()],
         }
     }
 
@@ -59,21 +44,10 @@ impl UncutBody {
             positions,
             device_displacements: None,
             cut: &self.cut,
-            heat: &self.von_mises,
+            heat: &self.heat,
             pinned: &[],
         }
     }
-}
-
-/// The pinned nodes of `solver`.
-pub fn pinned_nodes(solver: &Solver) -> Vec<u32> {
-    solver
-        .node_kinds()
-        .iter()
-        .enumerate()
-        .filter(|(_, k)| **k == NodeKind::Pinned)
-        .map(|(i, _)| i as u32)
-        .collect()
 }
 
 /// Which overlays are drawn.

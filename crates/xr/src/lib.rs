@@ -7,7 +7,12 @@
 //! wet-tissue material, and adds the switchable overlays (von Mises heat map, tet
 //! wireframe, tool spheres, pinned nodes), the tool mesh, lines drawn on the tissue
 //! surface (planned incisions) and a textured panel quad (result cards), with 4× MSAA into
-//! sRGB.
+//! sRGB. It draws a [`BodyState`] (positions, cut state, heat, pinned nodes), whatever
+//! method made it.
+//!
+//! Beside the renderer: [`openxr`], the OpenXR session and its frame logic (poses, tray,
+//! controls, lifecycle, the frame log), and [`simulated`], a headset without a runtime
+//! that plays a script, for tests and machines without a headset.
 
 pub mod camera;
 pub mod colour_map;
@@ -26,6 +31,7 @@ pub mod renderer;
 mod ribbon;
 mod scene_buffers;
 pub mod shaders;
+pub mod simulated;
 mod targets;
 pub mod tool_mesh;
 pub mod vulkan_instance;

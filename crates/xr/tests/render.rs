@@ -23,13 +23,26 @@ use incise_sim::selection::NodeSelection;
 use incise_sim::skin::Skin;
 use incise_sim::{Material, Solver, SolverParams, TetMesh};
 use incise_xr::compare::{Tolerance, compare};
-use incise_xr::frame::{MATERIAL_IDS, pinned_nodes};
+use incise_xr::frame::MATERIAL_IDS;
 use incise_xr::{
     BodyState, Camera, OffscreenRenderer, Overlays, RenderSettings, RgbaImage, ShadingMode,
     UncutBody, View,
 };
 
 const SIZE: (u32, u32) = (320, 240);
+
+/// The body of `solver` as the renderer sees it (host positions, von Mises heat);
+/// `pinned` lists its pinned nodes.
+fn solver_state<'a>(solver: &'a Solver, pinned: &'a [u32]) -> BodyState<'a> {
+    BodyState {
+        positions: solver.positions(),
+        device_displacements: None,
+        cut: solver.cut(),
+        heat: solver.von_mises(),
+        pinned,
+    }
+}
+
 /// The bar's cut threshold, Pa.
 // Cauchy von Mises (twice the seed's eq. 3 value, 6 kPa, at small strain).
 const BAR_THRESHOLD: f32 = 12e3;
@@ -185,7 +198,7 @@ fn golden_rest_intestine() {
 fn golden_torn_bar_shows_the_cut_where_it_tore() {
     let Some(dev) = device() else { return };
     let (mut s, skin) = tearing_bar();
-    let pinned = pinned_nodes(&s);
+    let pinned = s.pinned_nodes();
     let view = bar_view();
     let mut r = OffscreenRenderer::new(&dev, s.mesh(), &skin, SIZE, 1).unwrap();
     let ids = RenderSettings {
@@ -195,7 +208,7 @@ fn golden_torn_bar_shows_the_cut_where_it_tore() {
     let full = Vec2::new(SIZE.0 as f32, SIZE.1 as f32);
     // (a) Before the tear: no cut surface on screen.
     let before = r
-        .render_image(&BodyState::of_solver(&s, &pinned), &ids, &view)
+        .render_image(&solver_state(&s, &pinned), &ids, &view)
         .unwrap();
     assert_eq!(count_material(&before, "cut", Vec2::ZERO, full), 0);
     // The bar starts tearing at its pinned end in frame 25 (frames counted from 0).
@@ -204,7 +217,7 @@ fn golden_torn_bar_shows_the_cut_where_it_tore() {
         s.cut().released_count() > 0,
         "the bar should have torn by frame 27"
     );
-    let state = BodyState::of_solver(&s, &pinned);
+    let state = solver_state(&s, &pinned);
     let img = r
         .render_image(&state, &RenderSettings::default(), &view)
         .unwrap();
@@ -243,7 +256,7 @@ fn golden_torn_bar_shows_the_cut_where_it_tore() {
 fn golden_stress_overlay() {
     let Some(dev) = device() else { return };
     let (mut s, skin) = tearing_bar();
-    let pinned = pinned_nodes(&s);
+    let pinned = s.pinned_nodes();
     step(&mut s, 24);
     assert_eq!(s.cut().released_count(), 0, "still whole at frame 23");
     let mut r = OffscreenRenderer::new(&dev, s.mesh(), &skin, SIZE, 1).unwrap();
@@ -257,7 +270,7 @@ fn golden_stress_overlay() {
         ..RenderSettings::default()
     };
     let img = r
-        .render_image(&BodyState::of_solver(&s, &pinned), &settings, &bar_view())
+        .render_image(&solver_state(&s, &pinned), &settings, &bar_view())
         .unwrap();
     // The heat map's colours are neither skin nor cut surface: the whole picture only.
     check_golden("stress_overlay", &img, &[]);

@@ -8,14 +8,13 @@
 
 use ash::vk;
 use glam::{UVec3, Vec3};
+use incise_sim::TetMesh;
 use incise_sim::generate::block;
 use incise_sim::skin::Skin;
-use incise_sim::{Material, Solver, SolverParams, TetMesh};
 use incise_test_gate::{Need, or_skip};
-use incise_xr::frame::pinned_nodes;
 use incise_xr::openxr::swapchain::{EYE_FORMAT, wrap_image};
 use incise_xr::openxr::vulkan::{DirectVulkan, create_gpu};
-use incise_xr::{BodyState, Camera, RenderSettings, Renderer};
+use incise_xr::{Camera, RenderSettings, Renderer, UncutBody};
 use wgpu::hal;
 
 const SIZE: (u32, u32) = (96, 64);
@@ -107,13 +106,7 @@ fn a_foreign_vulkan_device_and_image_render_through_wgpu() {
         .unwrap()
         .0;
     let skin = Skin::from_boundary(&mesh);
-    let material = Material {
-        youngs_modulus: 1e4,
-        poisson_ratio: 0.3,
-        density: 1000.0,
-    };
-    let solver = Solver::new(mesh.clone(), material, SolverParams::default()).unwrap();
-    let pinned = pinned_nodes(&solver);
+    let body = UncutBody::new(&mesh);
     let mut renderer = Renderer::new(&dev.device, &dev.queue, EYE_FORMAT, &mesh, &skin);
     let view = Camera::framing(Vec3::ZERO, Vec3::splat(0.02), 0.5, 0.4)
         .view(SIZE.0 as f32 / SIZE.1 as f32);
@@ -123,7 +116,7 @@ fn a_foreign_vulkan_device_and_image_render_through_wgpu() {
         .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
     renderer.prepare(
         &mut enc,
-        &BodyState::of_solver(&solver, &pinned),
+        &body.state(&mesh.rest_positions),
         &RenderSettings::default(),
     );
     renderer.render(&mut enc, &[(view, &target)], SIZE);

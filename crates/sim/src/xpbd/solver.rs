@@ -304,6 +304,16 @@ impl Solver {
         &self.kind
     }
 
+    /// The pinned nodes' indices, ascending.
+    pub fn pinned_nodes(&self) -> Vec<u32> {
+        self.kind
+            .iter()
+            .enumerate()
+            .filter(|(_, k)| **k == NodeKind::Pinned)
+            .map(|(i, _)| i as u32)
+            .collect()
+    }
+
     /// von Mises stress per tet (mesh order) as of the last frame, Pa.
     pub fn von_mises(&self) -> &[f32] {
         &self.von_mises

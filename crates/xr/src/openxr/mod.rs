@@ -8,7 +8,8 @@
 //! [`backdrop`] (passthrough, alpha blend or an opaque room).
 //! Runtime side: [`runtime`] (loader, instance, headset), [`manifest`] (which runtime), [`vulkan`] (Vulkan through the
 //! runtime, wrapped into wgpu), [`swapchain`], [`actions`], [`passthrough`], [`session`]. The frame loop
-//! drives any [`headset::Headset`]: the OpenXR session or the app's simulated headset.
+//! drives any [`headset::Headset`]: the OpenXR session or the [`crate::simulated`] headset,
+//! and keeps a [`frame_log`] of every display frame.
 
 pub mod actions;
 pub mod backdrop;
@@ -16,6 +17,7 @@ pub mod bindings;
 pub mod controls;
 pub mod error;
 pub mod eye;
+pub mod frame_log;
 pub mod haptics;
 pub mod headset;
 pub mod lifecycle;

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
 use glam::{Quat, Vec2, Vec3};
-use incise_xr::openxr::pose::{Fov, XrPose};
+use incise_scalpel::ToolStroke;
 use serde::Deserialize;
 
-use crate::scene::ToolStroke;
+use super::error::ScriptError;
+use crate::openxr::pose::{Fov, XrPose};
 
 /// Quest 3 display rate used unless the script says otherwise, Hz.
 pub const QUEST3_HZ: f64 = 72.0;
@@ -189,37 +189,40 @@ pub enum Button {
 
 impl HeadsetScript {
     /// Read and check a script file.
-    pub fn load(path: &Path) -> Result<Self> {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        Self::parse(&text, path)
+    pub fn load(path: &Path) -> Result<Self, ScriptError> {
+        Self::parse(&incise_sim::ron_file::read(path)?, path)
     }
 
     /// Parse and check a script's text (`path` names it in errors).
-    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ScriptError> {
         let s: HeadsetScript = incise_sim::ron_file::parse(text, path)?;
-        s.validate().with_context(|| path.display().to_string())?;
+        s.validate(path)?;
         Ok(s)
     }
 
-    fn validate(&self) -> Result<()> {
+    /// Ok, or the first field out of range (`path` names the script).
+    fn validate(&self, path: &Path) -> Result<(), ScriptError> {
+        let bad = |field: &str, msg: String| Err(ScriptError::value(path, field, msg));
         if !(self.display_hz.is_finite() && (10.0..=1000.0).contains(&self.display_hz)) {
-            bail!("display_hz: must be 10 to 1000 Hz, got {}", self.display_hz);
+            return bad(
+                "display_hz",
+                format!("must be 10 to 1000 Hz, got {}", self.display_hz),
+            );
         }
         if !(self.duration.is_finite() && self.duration > 0.0) {
-            bail!(
-                "duration: must be a positive time in s, got {}",
-                self.duration
+            return bad(
+                "duration",
+                format!("must be a positive time in s, got {}", self.duration),
             );
         }
         if self.eye_size.0 == 0 || self.eye_size.1 == 0 {
-            bail!("eye_size: both sides must be at least 1 pixel");
+            return bad("eye_size", "both sides must be at least 1 pixel".into());
         }
         if self.render_every == 0 {
-            bail!("render_every: must be at least 1");
+            return bad("render_every", "must be at least 1".into());
         }
         if !(self.ipd.is_finite() && (0.0..0.2).contains(&self.ipd)) {
-            bail!("ipd: must be 0 to 0.2 m, got {}", self.ipd);
+            return bad("ipd", format!("must be 0 to 0.2 m, got {}", self.ipd));
         }
         let f = self.fov;
         if !(f.left < f.right && f.down < f.up)
@@ -227,19 +230,22 @@ impl HeadsetScript {
                 .iter()
                 .any(|a| !a.is_finite() || a.abs() >= 1.5)
         {
-            bail!("fov: needs left < right, down < up, each within ±1.5 rad");
+            return bad(
+                "fov",
+                "needs left < right, down < up, each within ±1.5 rad".into(),
+            );
         }
         if self.head.is_empty() {
-            bail!("head: needs at least one key");
+            return bad("head", "needs at least one key".into());
         }
-        check_times("head", self.head.iter().map(|k| k.t))?;
-        check_times("left", self.left.iter().map(|k| k.t))?;
-        check_times("trigger", self.trigger.iter().map(|k| k.0))?;
-        check_times("squeeze", self.squeeze.iter().map(|k| k.0))?;
-        check_times("stick", self.stick.iter().map(|k| k.0))?;
-        check_times("faults", self.faults.iter().map(|k| k.0))?;
+        check_times(path, "head", self.head.iter().map(|k| k.t))?;
+        check_times(path, "left", self.left.iter().map(|k| k.t))?;
+        check_times(path, "trigger", self.trigger.iter().map(|k| k.0))?;
+        check_times(path, "squeeze", self.squeeze.iter().map(|k| k.0))?;
+        check_times(path, "stick", self.stick.iter().map(|k| k.0))?;
+        check_times(path, "faults", self.faults.iter().map(|k| k.0))?;
         if let Some(RightTrack::Grip(keys)) = &self.right {
-            check_times("right", keys.iter().map(|k| k.t))?;
+            check_times(path, "right", keys.iter().map(|k| k.t))?;
         }
         Ok(())
     }
@@ -273,11 +279,21 @@ impl HeadsetScript {
     }
 }
 
-fn check_times(field: &str, times: impl Iterator<Item = f64>) -> Result<()> {
+/// Ok, or the first key of `field` (named `field[i].t`) whose time is not finite or runs
+/// backwards.
+fn check_times(
+    path: &Path,
+    field: &str,
+    times: impl Iterator<Item = f64>,
+) -> Result<(), ScriptError> {
     let mut last = f64::NEG_INFINITY;
     for (i, t) in times.enumerate() {
         if !t.is_finite() || t < last {
-            bail!("{field}[{i}].t: times must be finite and non-decreasing, got {t} after {last}");
+            return Err(ScriptError::value(
+                path,
+                &format!("{field}[{i}].t"),
+                format!("times must be finite and non-decreasing, got {t} after {last}"),
+            ));
         }
         last = t;
     }
@@ -365,14 +381,23 @@ mod tests {
     }
 
     #[test]
-    fn bad_fields_are_named() {
-        let s: HeadsetScript =
-            ron::from_str("(duration: -1.0, head: [(t: 0.0, position: (0.0, 1.5, 0.0))])").unwrap();
-        assert!(s.validate().unwrap_err().to_string().contains("duration"));
-        let s: HeadsetScript = ron::from_str(
-            "(duration: 1.0, head: [(t: 1.0, position: (0.0, 1.5, 0.0)), (t: 0.5, position: (0.0, 1.5, 0.0))])",
+    fn bad_fields_are_named_with_the_file() {
+        let path = Path::new("s.ron");
+        let e = HeadsetScript::parse(
+            "(duration: -1.0, head: [(t: 0.0, position: (0.0, 1.5, 0.0))])",
+            path,
         )
-        .unwrap();
-        assert!(s.validate().unwrap_err().to_string().contains("head[1].t"));
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("s.ron: duration: must be"), "{e}");
+        let e = HeadsetScript::parse(
+            "(duration: 1.0, head: [(t: 1.0, position: (0.0, 1.5, 0.0)), (t: 0.5, position: (0.0, 1.5, 0.0))])",
+            path,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.starts_with("s.ron: head[1].t: times must be"), "{e}");
+        let e = HeadsetScript::parse("(duration: 1.0,", path).unwrap_err();
+        assert!(matches!(e, ScriptError::Syntax(_)), "{e}");
     }
 }

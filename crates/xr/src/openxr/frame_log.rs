@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use incise_sim::MeshError;
 
 /// One display frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -78,10 +78,9 @@ impl FrameLog {
         s
     }
 
-    /// Write the CSV to `path`.
-    pub fn save(&self, path: &Path) -> Result<()> {
+    /// Write the CSV to `path` (the error names the file).
+    pub fn save(&self, path: &Path) -> Result<(), MeshError> {
         incise_sim::io::write_atomic(path, self.to_csv().as_bytes())
-            .with_context(|| format!("writing {}", path.display()))
     }
 
     /// The nominal display rate (Hz, from the shortest predicted period) and the display

@@ -7,18 +7,19 @@ use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::Result;
 use glam::Vec2;
 use incise_scalpel::Stroke;
-use incise_xr::offscreen::read_texture;
-use incise_xr::openxr::backdrop::Backdrop;
-use incise_xr::openxr::controls::ControllerState;
-use incise_xr::openxr::haptics::HapticPulse;
-use incise_xr::openxr::lifecycle::{FrameStage, Lifecycle, SessionPhase};
-use incise_xr::openxr::scalpel_pose::{BladeOffset, grip_for_scalpel};
-use incise_xr::openxr::tray::Tray;
-use incise_xr::openxr::{FrameEvent, Headset, HeadsetFrame, XrError};
-use incise_xr::{RenderDevice, RenderError};
+
+use crate::offscreen::read_texture;
+use crate::openxr::backdrop::Backdrop;
+use crate::openxr::controls::ControllerState;
+use crate::openxr::haptics::HapticPulse;
+use crate::openxr::lifecycle::{FrameStage, Lifecycle, SessionPhase};
+use crate::openxr::pose::XrPose;
+use crate::openxr::scalpel_pose::{BladeOffset, grip_for_scalpel};
+use crate::openxr::tray::Tray;
+use crate::openxr::{FrameEvent, Headset, HeadsetFrame, XrError};
+use crate::{RenderDevice, RenderError};
 
 use super::script::{Button, HeadsetScript, RightTrack, XrFault, stage_pose_at, track_at};
 
@@ -63,7 +64,7 @@ impl SimulatedHeadset {
         offset: BladeOffset,
         dev: RenderDevice,
         out: &Path,
-    ) -> Result<Self> {
+    ) -> Result<Self, RenderError> {
         let (w, h) = script.eye_size;
         let max = dev.limits.max_texture_dimension_2d;
         if w > max || h > max {
@@ -71,8 +72,7 @@ impl SimulatedHeadset {
                 width: w,
                 height: h,
                 why: format!("{} allows at most {max} pixels a side", dev.info.name),
-            }
-            .into());
+            });
         }
         // One texture per eye, as the XR session's one swapchain per eye.
         let textures = [0, 1].map(|_| {
@@ -299,10 +299,7 @@ impl Headset for SimulatedHeadset {
         let head = stage_pose_at(&self.script.head, t)
             .or_else(|| {
                 let last = self.script.head.last()?;
-                Some(incise_xr::openxr::pose::XrPose::new(
-                    last.position,
-                    last.orientation,
-                ))
+                Some(XrPose::new(last.position, last.orientation))
             })
             .unwrap_or_default();
         let focused = self.lifecycle.is_focused();
