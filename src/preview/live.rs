@@ -31,8 +31,8 @@ use incise_sim::gpu::GpuContext;
 pub struct Live {
     pub(super) shell: WindowShell,
     pub(super) opts: PreviewOptions,
-    /// The scene file and its name.
-    pub(super) scene: (PathBuf, String),
+    /// The scene file.
+    pub(super) scene: PathBuf,
     /// Where the body runs (cpu or gpu).
     pub(super) device: DeviceChoice,
     pub(super) body: RecordedBody,
@@ -66,14 +66,18 @@ pub fn preview_options(device: DeviceChoice, gpu: Option<GpuContext>) -> OpenOpt
     }
 }
 
-/// Open the scene at `path` for the window's device `gpu` (the solver on `device`).
+/// Open the scene at `path` for the window's device `gpu` (the solver on `device`): its
+/// body and the drawing of its first frame.
 pub(super) fn open_body(
     path: &Path,
     device: DeviceChoice,
     gpu: &WindowGpu,
-) -> Result<RecordedBody> {
+) -> Result<(RecordedBody, BodyDrawing)> {
     let opts = preview_options(device, Some(gpu.dev.compute_context()));
-    RecordedBody::open_with(path, &opts)
+    let body = RecordedBody::open_with(path, &opts)?;
+    let drawing = BodyDrawing::new(body.body.view(None))
+        .with_context(|| format!("{}: drawing", path.display()))?;
+    Ok((body, drawing))
 }
 
 /// The scalpel the mouse holds on `body` drawn as `drawing`: its scene's, else the
@@ -111,9 +115,7 @@ impl Live {
         let scene = exercise
             .as_ref()
             .map_or(opts.scene.clone(), |e| e.scene_path().to_path_buf());
-        let body = open_body(&scene, device, &shell.gpu)?;
-        let drawing = BodyDrawing::new(body.body.view(None))
-            .with_context(|| format!("{}: drawing", scene.display()))?;
+        let (body, drawing) = open_body(&scene, device, &shell.gpu)?;
         let home = preview_camera(drawing.mesh_and_skin().0);
         shell.set_home(home);
         let mut hand = hand_for(&body, &drawing, home.yaw)?;
@@ -126,7 +128,6 @@ impl Live {
             .parent()
             .filter(|d| !d.as_os_str().is_empty())
             .unwrap_or(Path::new("."));
-        let name = crate::scene::load_scene(&scene)?.name;
         Ok(Live {
             panel: Panel {
                 scenes: scene_files(scene_dir),
@@ -148,7 +149,7 @@ impl Live {
                 result_card: None,
                 show_result: false,
             },
-            scene: (scene, name),
+            scene,
             device,
             body,
             drawing,
@@ -171,7 +172,7 @@ impl Live {
         let frames = self.body.frames();
         let outcome = self.body.body.outcome().map(|o| o.summary);
         let lines = self.body.live_lines();
-        let mut out = format!("preview of {}: {frames} frames", self.scene.1);
+        let mut out = format!("preview of {}: {frames} frames", self.body.scene_name());
         if let Some(o) = outcome {
             out += &format!(", {o}");
         }
@@ -182,14 +183,12 @@ impl Live {
         Ok(out)
     }
 
-    /// Put `body` (a scene loaded, reset or retuned) in place, with its drawing and
-    /// renderer.
-    pub(super) fn replace_body(&mut self, body: RecordedBody) -> Result<()> {
-        self.drawing = BodyDrawing::new(body.body.view(None))
-            .with_context(|| format!("{}: drawing", self.scene.0.display()))?;
+    /// Put `body` (a scene loaded or reset) in place with its `drawing`, and a renderer
+    /// for them.
+    pub(super) fn replace_body(&mut self, (body, drawing): (RecordedBody, BodyDrawing)) {
         self.body = body;
+        self.drawing = drawing;
         self.renderer = renderer_for(&self.shell.gpu, &self.drawing, &self.hand);
-        Ok(())
     }
 
     /// Simulate one frame (kept for the exercise attempt under way); its time, ms.
@@ -204,11 +203,18 @@ impl Live {
         if let (Some(e), Some(frame)) = (&mut self.exercise, self.body.last_frame()) {
             e.after_step(ToolFrame::of(frame));
         }
+        self.redraw().map_err(|e| format!("{e:#}"))?;
+        Ok(t0.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// Draw the body as it is now (after a step or a retune), sharing with the last
+    /// drawing what has not changed; a new renderer when the topology or the body changed.
+    pub(super) fn redraw(&mut self) -> Result<()> {
         let view = self.body.body.view(self.drawing.cut_view());
-        if self.drawing.update(view).map_err(|e| format!("{e:#}"))? {
+        if self.drawing.update(view)? {
             self.renderer = renderer_for(&self.shell.gpu, &self.drawing, &self.hand);
         }
-        Ok(t0.elapsed().as_secs_f64() * 1e3)
+        Ok(())
     }
 
     /// What the renderer draws this frame besides the body: overlays, heat-map scale,
@@ -261,7 +267,7 @@ impl Live {
 
     /// `dir/<scene>_f<frame>.<ext>`: where the panel's buttons save.
     pub(super) fn snapshot_path(&self, dir: &str, ext: &str) -> PathBuf {
-        let stem = self.scene.0.file_stem().unwrap_or_default();
+        let stem = self.scene.file_stem().unwrap_or_default();
         let frame = self.body.frames();
         Path::new(dir).join(format!("{}_f{frame:05}.{ext}", stem.to_string_lossy()))
     }
@@ -300,7 +306,7 @@ impl WindowContent for Live {
             }
         }
         let t_render = Instant::now();
-        let live = (self.scene.0.as_path(), &self.body, &self.drawing);
+        let live = (self.scene.as_path(), &self.body, &self.drawing);
         let info = panel_info(live, &self.hand, self.exercise.as_ref(), &self.times);
         let panel = &mut self.panel;
         let (mut actions, mut panel_points) = (Vec::new(), 0.0);

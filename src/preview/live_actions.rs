@@ -11,7 +11,6 @@ use super::live::{Live, hand_for, open_body};
 use super::options::{ATTEMPTS_DIR, HISTORY_FILE, PreviewExercise};
 use super::panel::Action;
 use crate::exercise::live::attempt_pictures;
-use crate::pictures::body_drawing::BodyDrawing;
 
 impl Live {
     /// Do what the panel asked; a failure is shown in the panel.
@@ -84,14 +83,12 @@ impl Live {
 
     /// Open the scene at `path` in place of the current one.
     fn load_scene(&mut self, path: &Path) -> Result<()> {
-        let body = open_body(path, self.device, &self.shell.gpu)?;
-        let drawing = BodyDrawing::new(body.body.view(None))
-            .with_context(|| format!("{}: drawing", path.display()))?;
+        let (body, drawing) = open_body(path, self.device, &self.shell.gpu)?;
         let home = super::camera_input::preview_camera(drawing.mesh_and_skin().0);
         self.hand = hand_for(&body, &drawing, home.yaw)?;
         self.shell.set_home(home);
-        self.scene = (path.to_path_buf(), crate::scene::load_scene(path)?.name);
-        self.replace_body(body)?;
+        self.scene = path.to_path_buf();
+        self.replace_body((body, drawing));
         self.panel.draft = self.body.body.tunables();
         Ok(())
     }
@@ -100,12 +97,13 @@ impl Live {
     /// state, the script has it back where the scene has one (the mouse keeps it in an
     /// exercise).
     fn reload(&mut self) -> Result<()> {
-        let body = open_body(&self.scene.0, self.device, &self.shell.gpu)?;
+        let (body, drawing) = open_body(&self.scene, self.device, &self.shell.gpu)?;
         self.hand.fit(&body);
         if self.exercise.is_some() {
             self.hand.take_mouse(&body);
         }
-        self.replace_body(body)
+        self.replace_body((body, drawing));
+        Ok(())
     }
 
     /// Start over from rest with the settings in force.
@@ -128,10 +126,9 @@ impl Live {
         self.body
             .body
             .retune(settings, device)
-            .with_context(|| self.scene.0.display().to_string())?;
+            .with_context(|| self.scene.display().to_string())?;
         self.device = device;
-        let view = self.body.body.view(None);
-        self.drawing.update(view)?;
+        self.redraw()?;
         Ok("settings applied".into())
     }
 
@@ -150,7 +147,7 @@ impl Live {
             "saved {} poses to {}; replay: incise run {} --stroke {} --frames {}",
             r.poses,
             path.display(),
-            self.scene.0.display(),
+            self.scene.display(),
             path.display(),
             r.frames
         ))

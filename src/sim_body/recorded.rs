@@ -46,6 +46,11 @@ impl RecordedBody {
         })
     }
 
+    /// The scene's name (its `name` field).
+    pub fn scene_name(&self) -> &str {
+        &self.report.scene
+    }
+
     /// Frames stepped so far.
     pub fn frames(&self) -> usize {
         self.report.frames.len()

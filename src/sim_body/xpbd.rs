@@ -212,6 +212,20 @@ fn tool_info(t: &SceneTool) -> ToolInfo {
 }
 
 impl XpbdBody {
+    /// Go on with `material` and `params` on `device` ([`Solver::retuned`]: motion, cut,
+    /// grabs and tool carried over); refused settings leave the body as it was.
+    fn rebuild(
+        &mut self,
+        material: Material,
+        params: incise_sim::SolverParams,
+        device: DeviceChoice,
+    ) -> Result<()> {
+        let s = self.body.solver().retuned(material, params)?;
+        self.body = Body::place_on(s, device, self.gpu.as_ref(), |_| {})?;
+        self.material = material;
+        Ok(())
+    }
+
     /// Where `tool` puts the scalpel at the end of the next frame, and whether it holds
     /// it there without cutting: a hand's trigger up, or the stroke's lifted span (a
     /// recorded hand's).
@@ -437,12 +451,11 @@ impl SimBody for XpbdBody {
         }
         let mut params = old.params().clone();
         params.substeps = n;
-        let s = old.retuned(self.material, params)?;
-        self.body = match &self.body {
-            Body::Cpu(_) => Body::Cpu(Box::new(s)),
-            Body::Gpu(_) => Body::place_on(s, DeviceChoice::Gpu, self.gpu.as_ref(), |_| {})?,
+        let device = match &self.body {
+            Body::Cpu(_) => DeviceChoice::Cpu,
+            Body::Gpu(_) => DeviceChoice::Gpu,
         };
-        Ok(())
+        self.rebuild(self.material, params, device)
     }
 
     fn script_holds_tool(&self) -> bool {
@@ -482,10 +495,7 @@ impl SimBody for XpbdBody {
         params.release_threshold = t.cut_threshold;
         params.cut_zone = t.cut_zone;
         params.substeps = t.substeps;
-        let s = self.body.solver().retuned(material, params)?;
-        self.body = Body::place_on(s, device, self.gpu.as_ref(), |_| {})?;
-        self.material = material;
-        Ok(())
+        self.rebuild(material, params, device)
     }
 
     fn solver_parts(&self) -> Option<SolverParts<'_>> {
