@@ -31,10 +31,7 @@ fn preview_body(mode: &PreviewExercise) -> (RecordedBody, PreviewHand) {
     let opts = preview_options(DeviceChoice::Cpu, None);
     let body = RecordedBody::open_with(mode.scene_path(), &opts).unwrap();
     let mesh = mode.exercise.mesh.clone();
-    let tool = match body.body.solver_parts().and_then(|p| p.tool) {
-        Some(t) => t.clone(),
-        None => incise::scene::hand_tool::default_tool().unwrap(),
-    };
+    let tool = body.scalpel().unwrap();
     let hand = PreviewHand::new(tool, &body, mesh.rest_bounds(), default_camera(&mesh).yaw);
     (body, hand)
 }

@@ -87,12 +87,8 @@ pub(super) fn hand_for(
     drawing: &BodyDrawing,
     yaw: f32,
 ) -> Result<PreviewHand> {
-    let tool = match body.body.solver_parts().and_then(|p| p.tool) {
-        Some(t) => t.clone(),
-        None => crate::scene::hand_tool::default_tool()?,
-    };
     let bounds = drawing.mesh_and_skin().0.rest_bounds();
-    Ok(PreviewHand::new(tool, body, bounds, yaw))
+    Ok(PreviewHand::new(body.scalpel()?, body, bounds, yaw))
 }
 
 impl Live {

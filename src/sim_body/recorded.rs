@@ -46,6 +46,15 @@ impl RecordedBody {
         })
     }
 
+    /// The scalpel a hand or a scripted incision cuts this body with: the body's own (an
+    /// XPBD scene's), else the built-in No. 10.
+    pub fn scalpel(&self) -> Result<incise_scalpel::Tool> {
+        match self.body.solver_parts().and_then(|p| p.tool) {
+            Some(t) => Ok(t.clone()),
+            None => crate::scene::hand_tool::default_tool(),
+        }
+    }
+
     /// The scene's name (its `name` field).
     pub fn scene_name(&self) -> &str {
         &self.report.scene

@@ -249,7 +249,7 @@ fn run_simulated(
                 &script_path.parent().unwrap_or(Path::new(".")).join(f),
             )?,
             ToolStroke::Incision(i) => i
-                .stroke(&scalpel_of(&live)?)
+                .stroke(&live.body.scalpel()?)
                 .with_context(|| format!("{}: right.stroke", script_path.display()))?,
         }),
         _ => None,
@@ -259,13 +259,4 @@ fn run_simulated(
         SimulatedHeadset::new(script, stroke, tray, BladeOffset::default(), dev, &opts.out)?;
     let plan = plan(opts, scene, mode, (tray, nominal), exercise);
     session::run(&mut headset, (live, first), plan)
-}
-
-/// The scalpel a scripted incision is cut with: the body's own (an XPBD scene's), else
-/// the built-in one.
-fn scalpel_of(live: &LiveSim) -> Result<incise_scalpel::Tool> {
-    match live.body.body.solver_parts().and_then(|p| p.tool) {
-        Some(t) => Ok(t.clone()),
-        None => crate::scene::hand_tool::default_tool(),
-    }
 }
