@@ -7,10 +7,12 @@
 mod coarse_assembly;
 mod coarse_grid;
 mod coarse_system;
+mod eval_lanes;
 mod params;
 mod pcg;
 mod product_lanes;
 mod rest_tet;
+mod tet_evals;
 mod tet_tangent;
 mod workspace;
 

@@ -16,19 +16,31 @@ use crate::xpbd::lanes::{LANES, Lane, M3, V3, store_mat, store_vec};
 /// each value is one contiguous load (issue 35 item 2).
 #[derive(Debug, Clone, Copy)]
 pub struct RestLanes {
-    nodes: [[u32; 4]; LANES],
-    count: usize,
-    dm_inv: [[f32; LANES]; 9],
-    vb: [[[f32; LANES]; 3]; 3],
+    pub(super) nodes: [[u32; 4]; LANES],
+    pub(super) count: usize,
+    pub(super) dm_inv: [[f32; LANES]; 9],
+    pub(super) vb: [[[f32; LANES]; 3]; 3],
+    /// Rest volumes (0 in padding lanes).
+    pub(super) volume: [f32; LANES],
 }
 
 /// Eight tets' tangents at the current iterate: `F`, `cof F`, μ, c, s₃ (stored entry by
 /// entry across the lanes).
 #[derive(Debug, Clone, Copy)]
 pub struct TangentLanes {
-    f: [[f32; LANES]; 9],
-    cof: [[f32; LANES]; 9],
-    scalars: [[f32; LANES]; 3],
+    pub(super) f: [[f32; LANES]; 9],
+    pub(super) cof: [[f32; LANES]; 9],
+    pub(super) scalars: [[f32; LANES]; 3],
+}
+
+impl TangentLanes {
+    /// Lane `k`'s tangent.
+    pub fn tangent(&self, k: usize) -> TetTangent {
+        let entry =
+            |m: &[[f32; LANES]; 9]| Mat3::from_cols_array(&std::array::from_fn(|e| m[e][k]));
+        let [mu, c, s3] = self.scalars.map(|s| s[k]);
+        TetTangent::from_parts(entry(&self.f), entry(&self.cof), mu, c, s3)
+    }
 }
 
 /// The rest data of `tets` (shape gradients `b`) in chunks of eight.
@@ -41,9 +53,11 @@ pub fn rest_lanes(tets: &[RestTet], b: &[[Vec3; 4]]) -> Vec<RestLanes> {
                 count: t.len(),
                 dm_inv: [[0.0; LANES]; 9],
                 vb: [[[0.0; LANES]; 3]; 3],
+                volume: [0.0; LANES],
             };
             for k in 0..t.len() {
                 r.nodes[k] = t[k].nodes;
+                r.volume[k] = t[k].volume;
                 store_mat(&mut r.dm_inv, k, t[k].dm_inv);
                 for a in 0..3 {
                     store_vec(&mut r.vb[a], k, b[k][a + 1] * t[k].volume);

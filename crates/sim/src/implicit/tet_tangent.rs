@@ -51,11 +51,22 @@ impl TetTangent {
         }
     }
 
+    /// The tangent at rest (linear elasticity).
+    pub fn at_rest(lame: Lame) -> Self {
+        Self::at(&Strain::of(Mat3::ZERO), lame)
+    }
+
     /// `dP[dF]`, Pa.
     #[inline]
     pub fn dp(&self, df: &Mat3) -> Mat3 {
         let dj = frobenius(&self.cof, df);
         *df * self.mu + self.cof * (self.c * dj) + cofactor_differential(&self.f, df) * self.s3
+    }
+
+    /// The tangent of the parts [`TetTangent::parts`] gives.
+    #[inline]
+    pub(crate) fn from_parts(f: Mat3, cof: Mat3, mu: f32, c: f32, s3: f32) -> Self {
+        TetTangent { f, cof, mu, c, s3 }
     }
 
     /// `(F, cof F, μ, c, s₃)`: what the eight-lane product ([`super::product_lanes`]) packs.

@@ -19,14 +19,12 @@ use super::coarse_grid::CoarseGrid;
 use super::coarse_system::{CoarseError, CoarseSystem};
 use super::params::{CoarseRefresh, NewtonParams};
 use super::pcg::{dot, pcg};
-use super::product_lanes::{RestLanes, TangentLanes, product, rest_lanes, tangent_lanes};
 use super::rest_tet::RestTet;
+use super::tet_evals::{Iterate, TetEvals, for_each};
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
 use crate::mesh::TetMesh;
-use crate::vbd::{energy_density, piola, shape_gradients};
-use crate::xpbd::lanes::LANES;
-use crate::xpbd::{Strain, displacement_gradient};
+use crate::vbd::shape_gradients;
 
 /// Items per rayon task.
 const CHUNK: usize = 256;
@@ -55,15 +53,6 @@ pub struct NewtonReport {
     pub coarse_refresh_failed: bool,
 }
 
-/// One tet's evaluation at the current iterate.
-#[derive(Debug, Clone, Copy)]
-struct TetEval {
-    forces: [Vec3; 4],
-    diag: [Mat3; 4],
-    tangent: TetTangent,
-    energy: f32,
-}
-
 /// The Hessian of `G` applied matrix-free.
 struct Hessian {
     tets: Vec<RestTet>,
@@ -73,11 +62,10 @@ struct Hessian {
     mass: Vec<f32>,
     inv_h2: f32,
     lame: Lame,
-    evals: Vec<TetEval>,
+    /// The tets' evaluations, in chunks of eight for the SIMD kernels or tet by tet
+    /// (the reference).
+    evals: TetEvals,
     products: Vec<[Vec3; 4]>,
-    /// The tets in chunks of eight for the SIMD product, with their tangents (`None`:
-    /// the scalar product, the reference).
-    lanes: Option<(Vec<RestLanes>, Vec<TangentLanes>)>,
 }
 
 /// Block Jacobi plus the coarse correction.
@@ -129,26 +117,15 @@ impl NewtonWorkspace {
         let coarse = CoarseSystem::new(&grid, &tets, mass, inv_h2, lame)?;
         let (inc_offsets, inc) = (mesh.node_tet_offsets.clone(), mesh.node_corners());
         let n = mesh.node_count();
-        let rest = TetEval {
-            forces: [Vec3::ZERO; 4],
-            diag: [Mat3::ZERO; 4],
-            tangent: rest_tangent(lame),
-            energy: 0.0,
-        };
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
         let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
             .then(|| CoarseAssembly::new(&grid, &tets, &b, coarse.block_index()));
-        let lanes = lanes.then(|| {
-            let rest = rest_lanes(&tets, &b);
-            let tangents = vec![tangent_lanes(0, |_| rest_tangent(lame)); rest.len()];
-            (rest, tangents)
-        });
+        let evals = TetEvals::at_rest(&tets, &b, lame, lanes);
         Ok(NewtonWorkspace {
             params,
             hessian: Hessian {
                 b,
-                lanes,
-                evals: vec![rest; tets.len()],
+                evals,
                 products: vec![[Vec3::ZERO; 4]; tets.len()],
                 tets,
                 inc_offsets,
@@ -209,17 +186,18 @@ impl NewtonWorkspace {
         let mut g_now = self.hessian.evaluate(u, y, live, free, parallel);
         if self.refresh_due() {
             let evals = &self.hessian.evals;
-            let tangent = |t: usize| live[t].then(|| &evals[t].tangent);
             let pre = &mut self.pre;
+            // The blocks are these tangents' even where the factor stayed the old one.
+            pre.used.clear();
+            pre.used.extend((0..live.len()).map(|t| evals.tangent(t)));
+            let used = &pre.used;
+            let tangent = |t: usize| live[t].then(|| &used[t]);
             let assembly = pre
                 .assembly
                 .as_mut()
                 .expect("a refresh policy has an assembly");
             report.coarse_refreshed = true;
             report.coarse_refresh_failed = pre.coarse.refresh(assembly, tangent, parallel).is_err();
-            // The blocks are these tangents' even where the factor stayed the old one.
-            pre.used.clear();
-            pre.used.extend(evals.iter().map(|e| e.tangent));
             pre.since_refresh = 0;
         }
         self.pre.since_refresh += 1;
@@ -338,32 +316,14 @@ impl Hessian {
         free: &[bool],
         parallel: bool,
     ) -> f64 {
-        let (tets, b, lame) = (&self.tets, &self.b, self.lame);
-        let eval = |t: usize, out: &mut TetEval| {
-            if !live[t] {
-                out.energy = 0.0;
-                out.forces = [Vec3::ZERO; 4];
-                out.diag = [Mat3::ZERO; 4];
-                return;
-            }
-            let tet = &tets[t];
-            let s = tet.strain(u);
-            let p = piola(&s, lame) * tet.volume;
-            out.tangent = TetTangent::at(&s, lame);
-            out.energy = tet.volume * energy_density(&s, lame);
-            for (a, ba) in b[t].iter().enumerate() {
-                out.forces[a] = p * *ba;
-                out.diag[a] = out.tangent.diagonal_block(tet.volume, *ba);
-            }
+        let at = Iterate {
+            u,
+            live,
+            lame: self.lame,
+            b: &self.b,
+            parallel,
         };
-        for_each(parallel, &mut self.evals, eval);
-        if let Some((_, tangents)) = &mut self.lanes {
-            let evals = &self.evals;
-            for_each(parallel, tangents, |c, t| {
-                let chunk = &evals[c * LANES..(c * LANES + LANES).min(evals.len())];
-                *t = tangent_lanes(chunk.len(), |k| chunk[k].tangent);
-            });
-        }
+        self.evals.evaluate(&self.tets, at, true);
         self.total(u, y, free)
     }
 
@@ -378,22 +338,20 @@ impl Hessian {
         free: &[bool],
         parallel: bool,
     ) -> f64 {
-        let (tets, lame) = (&self.tets, self.lame);
-        let eval = |t: usize, out: &mut TetEval| {
-            out.energy = if live[t] {
-                let tet = &tets[t];
-                tet.volume * energy_density(&tet.strain(u), lame)
-            } else {
-                0.0
-            };
+        let at = Iterate {
+            u,
+            live,
+            lame: self.lame,
+            b: &self.b,
+            parallel,
         };
-        for_each(parallel, &mut self.evals, eval);
+        self.evals.evaluate(&self.tets, at, false);
         self.total(u, y, free)
     }
 
     /// `G` from the tets' energies and the inertia at `u`.
     fn total(&self, u: &[Vec3], y: &[Vec3], free: &[bool]) -> f64 {
-        let elastic: f64 = self.evals.iter().map(|e| e.energy as f64).sum();
+        let elastic = self.evals.elastic_energy();
         let inertia: f64 = (0..u.len())
             .filter(|&i| free[i])
             .map(|i| (self.mass[i] * (u[i] - y[i]).length_squared()) as f64)
@@ -421,9 +379,8 @@ impl Hessian {
             let mut g = (u[i] - y[i]) * m;
             let mut d = Mat3::IDENTITY * m;
             for &(t, a) in self.incident(i) {
-                let e = &self.evals[t as usize];
-                g += e.forces[a as usize];
-                d += e.diag[a as usize];
+                g += self.evals.force(t as usize, a as usize);
+                d += self.evals.diag(t as usize, a as usize);
             }
             *out.0 = g;
             *out.1 = d.inverse();
@@ -451,43 +408,15 @@ impl Hessian {
         free: &[bool],
         parallel: bool,
     ) {
-        if let Some((rest, tangents)) = &self.lanes {
-            let run = |(c, out): (usize, &mut [[Vec3; 4]])| {
-                let live = &live[c * LANES..(c * LANES + out.len())];
-                product(&rest[c], &tangents[c], live, p, out);
-            };
-            if parallel {
-                self.products
-                    .par_chunks_mut(LANES)
-                    .enumerate()
-                    .with_min_len(CHUNK / LANES)
-                    .for_each(run);
-            } else {
-                self.products.chunks_mut(LANES).enumerate().for_each(run);
-            }
-        } else {
-            self.scalar_products(p, live, parallel);
-        }
-        self.gather_products(p, out, free, parallel);
-    }
-
-    /// The tet-by-tet product (the reference for the lanes).
-    fn scalar_products(&mut self, p: &[Vec3], live: &[bool], parallel: bool) {
-        let (tets, b, evals) = (&self.tets, &self.b, &self.evals);
-        let product = |t: usize, f: &mut [Vec3; 4]| {
-            if !live[t] {
-                *f = [Vec3::ZERO; 4];
-                return;
-            }
-            let tet = &tets[t];
-            let dp = tet.nodes.map(|i| p[i as usize]);
-            let df = displacement_gradient(&dp, &tet.dm_inv);
-            let stress = evals[t].tangent.dp(&df) * tet.volume;
-            for a in 0..4 {
-                f[a] = stress * b[t][a];
-            }
+        let at = Iterate {
+            u: p,
+            live,
+            lame: self.lame,
+            b: &self.b,
+            parallel,
         };
-        for_each(parallel, &mut self.products, product);
+        self.evals.products(&self.tets, at, &mut self.products);
+        self.gather_products(p, out, free, parallel);
     }
 
     /// `out = M/h² p + Σ` the tets' forces at each free node (zero at fixed nodes).
@@ -530,27 +459,11 @@ impl TwoLevel {
     }
 }
 
-/// The tangent at rest.
-fn rest_tangent(lame: Lame) -> TetTangent {
-    TetTangent::at(&Strain::of(Mat3::ZERO), lame)
-}
-
-/// `f(i, &mut out[i])` for every item, on the pool's threads when `parallel`.
-fn for_each<T: Send>(parallel: bool, out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {
-    if parallel {
-        out.par_iter_mut()
-            .enumerate()
-            .with_min_len(CHUNK)
-            .for_each(|(i, o)| f(i, o));
-    } else {
-        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::generate::block;
+    use crate::xpbd::lanes::LANES;
 
     fn setup() -> (TetMesh, NewtonWorkspace, Vec<bool>) {
         let raw = block(
@@ -633,6 +546,110 @@ mod tests {
         assert!(
             scale > 0.0 && err <= 1e-5 * scale,
             "lanes off by {err} of {scale}"
+        );
+    }
+
+    /// The SIMD evaluation gives the scalar one's `G`, gradient, diagonal blocks and
+    /// tangents up to rounding, with tets stretched, squashed below `J_MIN` and inverted,
+    /// some released, and a tet count that is not a multiple of eight; the energy alone
+    /// is the evaluation's to the bit.
+    #[test]
+    fn the_lanes_evaluation_is_the_scalar_evaluation() {
+        let raw = block(
+            Vec3::ZERO,
+            Vec3::new(0.035, 0.015, 0.01),
+            glam::UVec3::new(7, 3, 2),
+        );
+        let mesh = TetMesh::from_raw(raw).unwrap().0;
+        assert_ne!(mesh.tet_count() % LANES, 0);
+        let free: Vec<bool> = mesh.rest_positions.iter().map(|p| p.x > 1e-4).collect();
+        let lame = Lame {
+            mu: 6.2e4,
+            lambda: 5.59e5,
+        };
+        let mass = mesh.lumped_masses(1040.0);
+        let make = |lanes| {
+            NewtonWorkspace::new(
+                &mesh,
+                &mass,
+                &free,
+                lame,
+                (1.0 / 60.0, lanes),
+                NewtonParams::default(),
+            )
+            .unwrap()
+        };
+        let (mut scalar, mut lanes) = (make(false), make(true));
+        let n = mesh.node_count();
+        let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 5 != 3).collect();
+        // Up to 4 mm on 5 mm cells: some tets flattened past J_MIN or inverted.
+        let u = wobble(n, 4e-3);
+        let y = wobble(n + 2, 1e-3)[2..].to_vec();
+        let j_min = crate::xpbd::J_MIN;
+        let squashed = (0..mesh.tet_count())
+            .filter(|&t| live[t] && RestTet::all(&mesh)[t].strain(&u).j() < j_min)
+            .count();
+        assert!(squashed > 0, "no tet below J_MIN");
+        let mut out = Vec::new();
+        for ws in [&mut scalar, &mut lanes] {
+            let g = ws.hessian.evaluate(&u, &y, &live, &free, true);
+            let e = ws.hessian.energy(&u, &y, &live, &free, true);
+            assert_eq!(
+                g.to_bits(),
+                e.to_bits(),
+                "the energy alone is not the evaluation's"
+            );
+            let (mut grad, mut d) = (vec![Vec3::ZERO; n], vec![Mat3::ZERO; n]);
+            ws.hessian
+                .gather_gradient(&u, &y, &free, &mut grad, &mut d, true);
+            let tangents: Vec<Mat3> = (0..mesh.tet_count())
+                .filter(|&t| live[t])
+                .map(|t| {
+                    ws.hessian
+                        .evals
+                        .tangent(t)
+                        .dp(&Mat3::from_diagonal(Vec3::ONE))
+                })
+                .collect();
+            out.push((g, grad, d, tangents));
+        }
+        let (a, b) = (&out[0], &out[1]);
+        assert!(
+            (a.0 - b.0).abs() <= 1e-5 * a.0.abs(),
+            "G {} vs {}",
+            a.0,
+            b.0
+        );
+        let worst = |x: &[Vec3], y: &[Vec3]| {
+            let scale = x.iter().map(|v| v.length()).fold(0.0, f32::max);
+            let err = x
+                .iter()
+                .zip(y)
+                .map(|(p, q)| (*p - *q).length())
+                .fold(0.0, f32::max);
+            (err, scale)
+        };
+        let (err, scale) = worst(&a.1, &b.1);
+        assert!(
+            scale > 0.0 && err <= 1e-4 * scale,
+            "gradient off by {err} of {scale}"
+        );
+        let cols = |m: &[Mat3]| -> Vec<Vec3> {
+            m.iter()
+                .flat_map(|m| [m.x_axis, m.y_axis, m.z_axis])
+                .collect()
+        };
+        // The blocks are compared inverted (as the preconditioner holds them), which
+        // multiplies their rounding by their condition number.
+        let (err, scale) = worst(&cols(&a.2), &cols(&b.2));
+        assert!(
+            scale > 0.0 && err <= 1e-3 * scale,
+            "blocks off by {err} of {scale}"
+        );
+        let (err, scale) = worst(&cols(&a.3), &cols(&b.3));
+        assert!(
+            scale > 0.0 && err <= 1e-4 * scale,
+            "tangents off by {err} of {scale}"
         );
     }
 

@@ -252,6 +252,15 @@ impl<L: Lane> M3<L> {
     pub fn norm2(&self) -> L {
         self.c0.length_squared() + self.c1.length_squared() + self.c2.length_squared()
     }
+
+    /// The entries as arrays, column-major as [`M3::load`] reads them.
+    #[inline(always)]
+    pub fn to_arrays(self) -> [[f32; LANES]; 9] {
+        let [c0, c1, c2] = [self.c0, self.c1, self.c2].map(V3::to_arrays);
+        [
+            c0[0], c0[1], c0[2], c1[0], c1[1], c1[2], c2[0], c2[1], c2[2],
+        ]
+    }
 }
 
 impl<L: Lane> Add for M3<L> {

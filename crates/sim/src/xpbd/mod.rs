@@ -13,7 +13,7 @@ mod neo_hookean;
 mod params;
 mod release_schedule;
 mod rest_free;
-mod rest_free_lanes;
+pub(crate) mod rest_free_lanes;
 mod retune;
 mod shared_nodes;
 mod solver;

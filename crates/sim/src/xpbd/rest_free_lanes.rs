@@ -29,7 +29,7 @@ pub struct TetLanes<L> {
 /// `x − ln(1 + x)`: the series below [`SERIES_LIMIT`], else direct (strain.rs
 /// `log1p_excess`).
 #[inline(always)]
-fn log1p_excess<L: Lane>(x: L) -> L {
+pub(crate) fn log1p_excess<L: Lane>(x: L) -> L {
     let s = L::splat;
     let x2 = x * x;
     let tail = s(-1.0 / 7.0) + x * s(0.125);
@@ -40,18 +40,25 @@ fn log1p_excess<L: Lane>(x: L) -> L {
 }
 
 /// The invariants of `F = I + H` from `H` (strain.rs `Strain`).
-struct StrainLanes<L> {
-    h: M3<L>,
-    tr: L,
-    i2: L,
-    det_h: L,
-    j1: L,
-    cof_h: M3<L>,
+pub(crate) struct StrainLanes<L> {
+    /// `H`.
+    pub(crate) h: M3<L>,
+    /// `tr H`.
+    pub(crate) tr: L,
+    /// `I₂(H)`.
+    pub(crate) i2: L,
+    /// `det H`.
+    pub(crate) det_h: L,
+    /// `J − 1`.
+    pub(crate) j1: L,
+    /// `cof H`.
+    pub(crate) cof_h: M3<L>,
 }
 
 impl<L: Lane> StrainLanes<L> {
+    /// The invariants of `I + h`.
     #[inline(always)]
-    fn of(h: M3<L>) -> Self {
+    pub(crate) fn of(h: M3<L>) -> Self {
         let tr = h.trace();
         let tr_h2 = h.mul_mat(&h).trace();
         let i2 = L::splat(0.5) * (tr * tr - tr_h2);
@@ -68,7 +75,7 @@ impl<L: Lane> StrainLanes<L> {
 
     /// `cof F = (1 + tr H) I − Hᵀ + cof H`.
     #[inline(always)]
-    fn cof_f(&self) -> M3<L> {
+    pub(crate) fn cof_f(&self) -> M3<L> {
         M3::diagonal(L::ONE + self.tr) - self.h.transpose() + self.cof_h
     }
 
@@ -84,7 +91,7 @@ impl<L: Lane> StrainLanes<L> {
 /// `excess = log1p_excess(J − 1)`.
 // docs/physics-notes.md, rest-free pair, C_H.
 #[inline(always)]
-fn log_volume<L: Lane>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
+pub(crate) fn log_volume<L: Lane>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
     let j = L::ONE + s.j1;
     let above = j.simd_gt(L::splat(J_MIN));
     let l = above.select(
@@ -95,16 +102,16 @@ fn log_volume<L: Lane>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
     (l, dl, above)
 }
 
-/// `C_D = sqrt(ψ̂)`, `∂C_D/∂F`, and the lanes where `C_D` has a direction
-/// (rest_free.rs `shape_energy`, `shape_constraint`), given `log_volume` and the excess.
-// docs/physics-notes.md, rest-free pair, C_D.
+/// `ψ̂ ≥ 0` and `½ ∂ψ̂/∂F = F − L' cof F` (rest_free.rs `shape_energy`), given
+/// `log_volume` and the excess.
+// docs/physics-notes.md, rest-free pair, C_D² = ψ̂.
 #[inline(always)]
-fn shape_constraint<L: Lane>(
+pub(crate) fn shape_energy<L: Lane>(
     s: &StrainLanes<L>,
     volume: (L, L, L),
     excess: L,
     cof_f: &M3<L>,
-) -> (L, M3<L>, L) {
+) -> (L, M3<L>) {
     let (l, dl, above) = volume;
     let two = L::splat(2.0);
     let h_norm2 = s.h.norm2();
@@ -114,14 +121,28 @@ fn shape_constraint<L: Lane>(
     let psi = above.select(psi_above, psi_below).max(L::ZERO);
     let grad_above = s.j_f_minus_cof() * (L::ONE / j);
     let grad_below = M3::diagonal(L::ONE) + s.h - *cof_f * dl;
+    (psi, select_m3(above, &grad_above, &grad_below))
+}
+
+/// `C_D = sqrt(ψ̂)`, `∂C_D/∂F`, and the lanes where `C_D` has a direction
+/// (rest_free.rs `shape_constraint`), given `log_volume` and the excess.
+// docs/physics-notes.md, rest-free pair, C_D.
+#[inline(always)]
+fn shape_constraint<L: Lane>(
+    s: &StrainLanes<L>,
+    volume: (L, L, L),
+    excess: L,
+    cof_f: &M3<L>,
+) -> (L, M3<L>, L) {
+    let (psi, half) = shape_energy(s, volume, excess, cof_f);
     let c = psi.sqrt();
     let has = c.simd_ge(L::splat(MIN_SHAPE));
-    let half = select_m3(above, &grad_above, &grad_below);
     (c, half * (L::ONE / c), has)
 }
 
+/// `a` in the lanes where `m` is set, else `b`.
 #[inline(always)]
-fn select_v3<L: Lane>(m: L, a: V3<L>, b: V3<L>) -> V3<L> {
+pub(crate) fn select_v3<L: Lane>(m: L, a: V3<L>, b: V3<L>) -> V3<L> {
     V3 {
         x: m.select(a.x, b.x),
         y: m.select(a.y, b.y),
@@ -129,8 +150,9 @@ fn select_v3<L: Lane>(m: L, a: V3<L>, b: V3<L>) -> V3<L> {
     }
 }
 
+/// `a` in the lanes where `m` is set, else `b`.
 #[inline(always)]
-fn select_m3<L: Lane>(m: L, a: &M3<L>, b: &M3<L>) -> M3<L> {
+pub(crate) fn select_m3<L: Lane>(m: L, a: &M3<L>, b: &M3<L>) -> M3<L> {
     M3 {
         c0: select_v3(m, a.c0, b.c0),
         c1: select_v3(m, a.c1, b.c1),

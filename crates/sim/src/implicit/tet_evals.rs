@@ -1,0 +1,251 @@
+//! The tets' evaluations at the Newton step's current iterate (forces, diagonal Hessian
+//! blocks, energies and stress tangents), kept tet by tet (the scalar reference) or eight
+//! tets to a chunk ([`super::eval_lanes`], what the SIMD product reads).
+
+use glam::{Mat3, Vec3};
+
+use super::eval_lanes::{self, EvalLanes};
+use super::product_lanes::{RestLanes, TangentLanes, product, rest_lanes, tangent_lanes};
+use super::rest_tet::RestTet;
+use super::tet_tangent::TetTangent;
+use crate::material::Lame;
+use crate::vbd::{energy_density, piola};
+use crate::xpbd::displacement_gradient;
+use crate::xpbd::lanes::LANES;
+
+/// One tet's evaluation at the current iterate.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct TetEval {
+    /// Nodal forces `V P b_a`.
+    pub(super) forces: [Vec3; 4],
+    /// Diagonal Hessian blocks.
+    pub(super) diag: [Mat3; 4],
+    /// Stress tangent.
+    pub(super) tangent: TetTangent,
+    /// `V Ψ`.
+    pub(super) energy: f32,
+}
+
+/// Every tet's evaluation, in one of the two layouts.
+pub(super) enum TetEvals {
+    /// Tet by tet (`cpu_kernel: Scalar`, the reference).
+    Scalar(Vec<TetEval>),
+    /// In chunks of eight, with the chunks' rest data.
+    Lanes {
+        /// The chunks' nodes, `Dm⁻¹`, `V b_a` and volumes.
+        rest: Vec<RestLanes>,
+        /// Forces, blocks and energies.
+        evals: Vec<EvalLanes>,
+        /// Stress tangents.
+        tangents: Vec<TangentLanes>,
+    },
+}
+
+impl TetEvals {
+    /// Every tet at rest (tangents of linear elasticity), in lanes or tet by tet.
+    pub(super) fn at_rest(tets: &[RestTet], b: &[[Vec3; 4]], lame: Lame, lanes: bool) -> Self {
+        let tangent = TetTangent::at_rest(lame);
+        if !lanes {
+            let rest = TetEval {
+                forces: [Vec3::ZERO; 4],
+                diag: [Mat3::ZERO; 4],
+                tangent,
+                energy: 0.0,
+            };
+            return TetEvals::Scalar(vec![rest; tets.len()]);
+        }
+        let rest = rest_lanes(tets, b);
+        TetEvals::Lanes {
+            evals: vec![EvalLanes::ZERO; rest.len()],
+            tangents: vec![tangent_lanes(0, |_| tangent); rest.len()],
+            rest,
+        }
+    }
+
+    /// The force of tet `t` on its corner `a`.
+    #[inline]
+    pub(super) fn force(&self, t: usize, a: usize) -> Vec3 {
+        match self {
+            TetEvals::Scalar(e) => e[t].forces[a],
+            TetEvals::Lanes { evals, .. } => evals[t / LANES].force(t % LANES, a),
+        }
+    }
+
+    /// The diagonal Hessian block of tet `t` at its corner `a`.
+    #[inline]
+    pub(super) fn diag(&self, t: usize, a: usize) -> Mat3 {
+        match self {
+            TetEvals::Scalar(e) => e[t].diag[a],
+            TetEvals::Lanes { evals, .. } => evals[t / LANES].diag(t % LANES, a),
+        }
+    }
+
+    /// The stress tangent of tet `t`.
+    pub(super) fn tangent(&self, t: usize) -> TetTangent {
+        match self {
+            TetEvals::Scalar(e) => e[t].tangent,
+            TetEvals::Lanes { tangents, .. } => tangents[t / LANES].tangent(t % LANES),
+        }
+    }
+
+    /// `Σ V Ψ` over the tets, in tet order, in f64.
+    pub(super) fn elastic_energy(&self) -> f64 {
+        match self {
+            TetEvals::Scalar(e) => e.iter().map(|e| e.energy as f64).sum(),
+            TetEvals::Lanes { evals, rest, .. } => evals
+                .iter()
+                .zip(rest)
+                .flat_map(|(e, r)| e.energies()[..r.count].iter())
+                .map(|&e| e as f64)
+                .sum(),
+        }
+    }
+
+    /// Evaluate every tet at `u` (`full` false: the energies alone, the rest kept).
+    pub(super) fn evaluate(&mut self, tets: &[RestTet], at: Iterate, full: bool) {
+        match self {
+            TetEvals::Scalar(evals) => {
+                for_each(at.parallel, evals, |t, out| {
+                    scalar_eval(&tets[t], &at.b[t], at, at.live[t], full, out)
+                });
+            }
+            TetEvals::Lanes {
+                rest,
+                evals,
+                tangents,
+            } => {
+                let run = |c: usize, (out, tan): (&mut EvalLanes, &mut TangentLanes)| {
+                    let live = &at.live[c * LANES..c * LANES + rest[c].count];
+                    if full {
+                        eval_lanes::evaluate(&rest[c], live, at.u, at.lame, out, tan);
+                    } else {
+                        eval_lanes::energy(&rest[c], live, at.u, at.lame, out);
+                    }
+                };
+                for_each_pair(at.parallel, evals, tangents, run);
+            }
+        }
+    }
+}
+
+impl TetEvals {
+    /// Each live tet's nodal forces `V dP[dF(p)] b_a` for the direction `p = at.u` at the
+    /// last evaluation's tangents (zero for the others), into `out` (one entry per tet):
+    /// the tets' part of the Hessian product.
+    pub(super) fn products(&self, tets: &[RestTet], at: Iterate, out: &mut [[Vec3; 4]]) {
+        match self {
+            TetEvals::Lanes { rest, tangents, .. } => {
+                let run = |(c, out): (usize, &mut [[Vec3; 4]])| {
+                    let live = &at.live[c * LANES..(c * LANES + out.len())];
+                    product(&rest[c], &tangents[c], live, at.u, out);
+                };
+                if at.parallel {
+                    use rayon::prelude::*;
+                    out.par_chunks_mut(LANES)
+                        .enumerate()
+                        .with_min_len(CHUNK / LANES)
+                        .for_each(run);
+                } else {
+                    out.chunks_mut(LANES).enumerate().for_each(run);
+                }
+            }
+            TetEvals::Scalar(evals) => for_each(at.parallel, out, |t, f| {
+                *f = if at.live[t] {
+                    scalar_product(&tets[t], &at.b[t], &evals[t].tangent, at.u)
+                } else {
+                    [Vec3::ZERO; 4]
+                };
+            }),
+        }
+    }
+}
+
+/// One tet's nodal forces for the direction `p` (the reference for the lanes).
+// docs/physics-notes.md, "The implicit scheme" (the exact Hessian, matrix-free).
+fn scalar_product(tet: &RestTet, b: &[Vec3; 4], tangent: &TetTangent, p: &[Vec3]) -> [Vec3; 4] {
+    let dp = tet.nodes.map(|i| p[i as usize]);
+    let df = displacement_gradient(&dp, &tet.dm_inv);
+    let stress = tangent.dp(&df) * tet.volume;
+    b.map(|b| stress * b)
+}
+
+/// Where the tets are evaluated (or, for [`TetEvals::products`], the direction): the
+/// displacements, which tets are live, the material, the shape gradients and whether on
+/// the pool's threads.
+#[derive(Clone, Copy)]
+pub(super) struct Iterate<'a> {
+    /// Node displacements.
+    pub(super) u: &'a [Vec3],
+    /// Per tet, mesh order.
+    pub(super) live: &'a [bool],
+    /// The material.
+    pub(super) lame: Lame,
+    /// Shape gradients `b_a` per tet.
+    pub(super) b: &'a [[Vec3; 4]],
+    /// On the pool's threads.
+    pub(super) parallel: bool,
+}
+
+/// One tet's evaluation (`full` false: its energy alone).
+// PHYSICS.md §1.2 (the rest-free pair's energy); docs/physics-notes.md, "The implicit scheme".
+fn scalar_eval(
+    tet: &RestTet,
+    b: &[Vec3; 4],
+    at: Iterate,
+    live: bool,
+    full: bool,
+    out: &mut TetEval,
+) {
+    if !live {
+        out.energy = 0.0;
+        out.forces = [Vec3::ZERO; 4];
+        out.diag = [Mat3::ZERO; 4];
+        return;
+    }
+    let s = tet.strain(at.u);
+    out.energy = tet.volume * energy_density(&s, at.lame);
+    if !full {
+        return;
+    }
+    let p = piola(&s, at.lame) * tet.volume;
+    out.tangent = TetTangent::at(&s, at.lame);
+    for (a, ba) in b.iter().enumerate() {
+        out.forces[a] = p * *ba;
+        out.diag[a] = out.tangent.diagonal_block(tet.volume, *ba);
+    }
+}
+
+/// Items per rayon task.
+const CHUNK: usize = 256;
+
+/// `f(i, &mut out[i])` for every item, on the pool's threads when `parallel`.
+pub(super) fn for_each<T: Send>(parallel: bool, out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {
+    use rayon::prelude::*;
+    if parallel {
+        out.par_iter_mut()
+            .enumerate()
+            .with_min_len(CHUNK)
+            .for_each(|(i, o)| f(i, o));
+    } else {
+        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
+    }
+}
+
+/// `f(i, (&mut a[i], &mut b[i]))` for every pair, on the pool's threads when `parallel`.
+fn for_each_pair<A: Send, B: Send>(
+    parallel: bool,
+    a: &mut [A],
+    b: &mut [B],
+    f: impl Fn(usize, (&mut A, &mut B)) + Sync,
+) {
+    use rayon::prelude::*;
+    if parallel {
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .enumerate()
+            .with_min_len(CHUNK / LANES)
+            .for_each(|(i, p)| f(i, p));
+    } else {
+        a.iter_mut().zip(b).enumerate().for_each(|(i, p)| f(i, p));
+    }
+}
