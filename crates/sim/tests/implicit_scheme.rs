@@ -1,13 +1,14 @@
 //! The implicit scheme (`solver.scheme: Newton`, `incise_sim::implicit`): a cantilever
 //! settles on the static solution of its own mesh, a bar pulled until it tears tears as
 //! the XPBD reference does (with the coarse level at rest stiffness and refreshed from the
-//! current tangents), a refreshed coarse level saves products on a bent beam, and unusable
-//! settings are refused naming the field.
+//! current tangents, and with the Gauss–Seidel smoother), a refreshed coarse level and the
+//! Gauss–Seidel smoother save products on a bent beam, and unusable settings are refused
+//! naming the field.
 
 mod common;
 
 use glam::{DVec3, UVec3, Vec3};
-use incise_sim::implicit::{CoarseRefresh, NewtonParams, Scheme};
+use incise_sim::implicit::{CoarseRefresh, NewtonParams, Scheme, Smoother};
 use incise_sim::xpbd::ConstraintPair;
 use incise_sim::{Solver, SolverParams};
 
@@ -20,6 +21,7 @@ const CONVERGED: NewtonParams = NewtonParams {
     gradient_tolerance: 0.0,
     coarse_cell: None,
     coarse_refresh: CoarseRefresh::Rest,
+    smoother: Smoother::Jacobi,
 };
 
 /// A 20 × 2 × 2 cm cantilever (E = 3 MPa, ν = 0.45) pinned at x = 0 under gravity settles
@@ -101,40 +103,46 @@ fn a_pulled_bar_tears_as_the_xpbd_reference_does() {
     let ref_first = ref_first.expect("XPBD tears");
     // The refreshed coarse level spans the cut with cubes too: it must not hold the two
     // sides together (it only preconditions; a released tet drops out of it).
-    for coarse_refresh in [CoarseRefresh::Rest, CoarseRefresh::Steps(1)] {
+    for (coarse_refresh, smoother) in [
+        (CoarseRefresh::Rest, Smoother::Jacobi),
+        (CoarseRefresh::Steps(1), Smoother::Jacobi),
+        (CoarseRefresh::Steps(1), Smoother::GaussSeidel),
+    ] {
         let (first, released, s) = run(common::tearing_bar_with(|p| {
             p.threads = 1;
             p.scheme = Scheme::Newton(NewtonParams {
                 steps: 4,
                 coarse_refresh,
+                smoother,
                 ..CONVERGED
             });
         }));
         let first = first.expect("Newton tears");
         assert!(
             first.abs_diff(ref_first) <= 2,
-            "{coarse_refresh:?}: first release {first} against {ref_first}"
+            "{coarse_refresh:?}, {smoother:?}: first release {first} against {ref_first}"
         );
         let off = released.abs_diff(ref_released) as f64 / ref_released as f64;
         assert!(
             off <= 0.15,
-            "{coarse_refresh:?}: {released} released against {ref_released}"
+            "{coarse_refresh:?}, {smoother:?}: {released} released against {ref_released}"
         );
         // The cut is open: the live tets fall into two or more pieces.
         let comps =
             incise_sim::mesh::topology::connected_components(s.mesh(), |t| s.cut().is_live(t));
         assert!(
             comps >= 2,
-            "{coarse_refresh:?}: the bar is still in one piece after tearing"
+            "{coarse_refresh:?}, {smoother:?}: the bar is still in one piece after tearing"
         );
     }
 }
 
 /// A soft cantilever bent a quarter of its length under gravity: the rest stiffness
 /// misses the rotation of its tets, so the coarse level refreshed from the current
-/// tangents needs fewer products a frame once bent, and both settle on the same sag.
+/// tangents needs fewer products a frame once bent, and both settle on the same sag; the
+/// Gauss–Seidel smoother settles there on fewer products still.
 #[test]
-fn a_refreshed_coarse_level_saves_products_on_a_bent_beam() {
+fn a_refreshed_coarse_level_and_gauss_seidel_save_products_on_a_bent_beam() {
     let mesh = common::block_mesh(
         Vec3::new(0.0, -0.01, -0.01),
         Vec3::new(0.2, 0.02, 0.02),
@@ -146,12 +154,13 @@ fn a_refreshed_coarse_level_saves_products_on_a_bent_beam() {
     let tip: Vec<usize> = (0..mesh.node_count())
         .filter(|&i| mesh.rest_positions[i].x > 0.2 - 1e-4)
         .collect();
-    let run = |coarse_refresh| {
+    let run = |coarse_refresh, smoother| {
         let params = SolverParams {
             scheme: Scheme::Newton(NewtonParams {
                 cg_tolerance: 1e-2,
                 gradient_tolerance: 1e-3,
                 coarse_refresh,
+                smoother,
                 ..CONVERGED
             }),
             damping: 20.0,
@@ -175,8 +184,9 @@ fn a_refreshed_coarse_level_saves_products_on_a_bent_beam() {
             / tip.len() as f32;
         (late_products, sag)
     };
-    let (rest, rest_sag) = run(CoarseRefresh::Rest);
-    let (fresh, fresh_sag) = run(CoarseRefresh::Steps(1));
+    let (rest, rest_sag) = run(CoarseRefresh::Rest, Smoother::Jacobi);
+    let (fresh, fresh_sag) = run(CoarseRefresh::Steps(1), Smoother::Jacobi);
+    let (smoothed, smoothed_sag) = run(CoarseRefresh::Steps(1), Smoother::GaussSeidel);
     assert!(
         rest_sag > 0.05,
         "bent a quarter of its length: sag {rest_sag} m"
@@ -188,6 +198,15 @@ fn a_refreshed_coarse_level_saves_products_on_a_bent_beam() {
     assert!(
         (fresh as f64) < 0.8 * rest as f64,
         "products over frames 30-59: {fresh} refreshed against {rest} at rest stiffness"
+    );
+    // The Gauss–Seidel smoother: the same sag for fewer products than block Jacobi.
+    assert!(
+        (smoothed_sag / fresh_sag - 1.0).abs() < 0.01,
+        "sag {smoothed_sag} with Gauss–Seidel against {fresh_sag} with Jacobi"
+    );
+    assert!(
+        (smoothed as f64) < 0.7 * fresh as f64,
+        "products over frames 30-59: {smoothed} with Gauss–Seidel against {fresh} with Jacobi"
     );
 }
 
@@ -237,8 +256,12 @@ fn unusable_newton_settings_are_refused() {
 /// is evaluated from `H`, so rest is force-free to the last bit), at ν up to 0.499.
 #[test]
 fn rest_stays_exactly_at_rest() {
-    let policies = [CoarseRefresh::Rest, CoarseRefresh::Steps(1)];
-    for (nu, coarse_refresh) in [0.0, 0.3, 0.45, 0.499]
+    let policies = [
+        (CoarseRefresh::Rest, Smoother::Jacobi),
+        (CoarseRefresh::Steps(1), Smoother::Jacobi),
+        (CoarseRefresh::Steps(1), Smoother::GaussSeidel),
+    ];
+    for (nu, (coarse_refresh, smoother)) in [0.0, 0.3, 0.45, 0.499]
         .into_iter()
         .flat_map(|nu| policies.map(|p| (nu, p)))
     {
@@ -246,6 +269,7 @@ fn rest_stays_exactly_at_rest() {
         let params = SolverParams {
             scheme: Scheme::Newton(NewtonParams {
                 coarse_refresh,
+                smoother,
                 ..NewtonParams::default()
             }),
             gravity: Vec3::ZERO,
@@ -258,7 +282,10 @@ fn rest_stays_exactly_at_rest() {
             s.step_frame().unwrap();
         }
         let moved = common::max_displacement(&s);
-        assert_eq!(moved, 0.0, "ν = {nu}, {coarse_refresh:?}: moved {moved} m");
+        assert_eq!(
+            moved, 0.0,
+            "ν = {nu}, {coarse_refresh:?}, {smoother:?}: moved {moved} m"
+        );
     }
 }
 

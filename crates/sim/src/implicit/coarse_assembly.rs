@@ -371,7 +371,7 @@ fn balanced_parts(groups: &[Group]) -> Vec<Range<usize>> {
 /// `V A_jk` with the volume folded into `(μ, c, s₃)`: `μ (β_j·β_k) I + c a_j a_kᵀ −
 /// s₃ [F (β_j × β_k)]ₓ`, `a = cof F β` (module docs; PHYSICS.md §1.2).
 #[inline]
-fn pair_block(
+pub(super) fn pair_block(
     bj: Vec3,
     bk: Vec3,
     (aj, ak): (Vec3, Vec3),

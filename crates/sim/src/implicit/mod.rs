@@ -1,9 +1,10 @@
 //! The implicit scheme's pieces: one implicit Euler step per (frame / `steps`), its
 //! minimisation by Newton's method, each Newton system by a conjugate gradient
-//! preconditioned on two levels (block Jacobi on the tet mesh, a Cholesky-factorised
-//! Galerkin coarse grid). The tet solver ([`crate::xpbd::Solver`]) drives them when
+//! preconditioned on two levels (block Jacobi or symmetric Gauss–Seidel on the tet mesh, a
+//! Cholesky-factorised Galerkin coarse grid). The tet solver ([`crate::xpbd::Solver`]) drives them when
 //! `solver.scheme` is `Newton`.
 
+mod block_matrix;
 mod coarse_assembly;
 mod coarse_grid;
 mod coarse_system;
@@ -18,7 +19,7 @@ mod workspace;
 
 pub use coarse_grid::CoarseGrid;
 pub use coarse_system::{CoarseError, CoarseSystem};
-pub use params::{CoarseRefresh, NewtonParams, Scheme};
+pub use params::{CoarseRefresh, NewtonParams, Scheme, Smoother};
 pub use pcg::{CgReport, dot, pcg};
 pub use rest_tet::RestTet;
 pub use tet_tangent::TetTangent;

@@ -44,6 +44,21 @@ pub struct NewtonParams {
     /// Which stiffness the coarse level's matrix holds and when it is rebuilt (default:
     /// the current tangents every 8 steps, docs/physics-notes.md "The implicit scheme").
     pub coarse_refresh: CoarseRefresh,
+    /// The fine level of the preconditioner (default: block Jacobi).
+    pub smoother: Smoother,
+}
+
+/// The fine level of the implicit scheme's preconditioner (`solver.scheme:
+/// Newton((smoother: …))`), added to the coarse correction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Smoother {
+    /// Each free node's 3×3 diagonal block of the Hessian, inverted.
+    #[default]
+    Jacobi,
+    /// One symmetric block Gauss–Seidel sweep on the Hessian assembled at the step's first
+    /// iterate (positive semi-definite part of each tet's tangent); an iteration whose
+    /// first direction meets negative curvature is solved again with `Jacobi`.
+    GaussSeidel,
 }
 
 /// The stiffness in the coarse level's Galerkin matrix `Pᵀ (M/h² + K) P`
@@ -72,6 +87,7 @@ impl Default for NewtonParams {
             gradient_tolerance: 0.01,
             coarse_cell: None,
             coarse_refresh: CoarseRefresh::Steps(8),
+            smoother: Smoother::Jacobi,
         }
     }
 }

@@ -8,16 +8,19 @@
 //! over the free nodes (pinned and grabbed nodes hold their targets). Each Newton
 //! iteration solves `∇²G d = −∇G` by [`pcg`] with the exact Hessian applied tet by tet
 //! ([`TetTangent`]) and a two-level preconditioner: block Jacobi (each node's 3×3
-//! diagonal block, as VBD's local system) plus a coarse-grid correction `P A_c⁻¹ Pᵀ`
-//! ([`CoarseSystem`]). A backtracking line search on `G` keeps every step a descent.
+//! diagonal block, as VBD's local system) or, with `smoother: GaussSeidel`, a symmetric
+//! block Gauss–Seidel sweep on the Hessian assembled at the step's first iterate
+//! ([`BlockMatrix`]), plus a coarse-grid correction `P A_c⁻¹ Pᵀ` ([`CoarseSystem`]). A
+//! backtracking line search on `G` keeps every step a descent.
 
 use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
+use super::block_matrix::BlockMatrix;
 use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
 use super::coarse_system::{CoarseError, CoarseSystem};
-use super::params::{CoarseRefresh, NewtonParams};
+use super::params::{CoarseRefresh, NewtonParams, Smoother};
 use super::pcg::{dot, pcg};
 use super::rest_tet::RestTet;
 use super::tet_evals::{Iterate, TetEvals, for_each};
@@ -80,6 +83,8 @@ struct TwoLevel {
     used: Vec<TetTangent>,
     /// Steps since the last refresh.
     since_refresh: u32,
+    /// The assembled Hessian for the Gauss–Seidel smoother (`None`: block Jacobi).
+    matrix: Option<BlockMatrix>,
     rhs: Vec<f64>,
 }
 
@@ -121,6 +126,7 @@ impl NewtonWorkspace {
         let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
             .then(|| CoarseAssembly::new(&grid, &tets, &b, coarse.block_index()));
         let evals = TetEvals::at_rest(&tets, &b, lame, lanes);
+        let matrix = (params.smoother == Smoother::GaussSeidel).then(|| BlockMatrix::new(n, &tets));
         Ok(NewtonWorkspace {
             params,
             hessian: Hessian {
@@ -142,6 +148,7 @@ impl NewtonWorkspace {
                 assembly,
                 used: Vec::new(),
                 since_refresh: 0,
+                matrix,
             },
             gradient: vec![Vec3::ZERO; n],
             rhs: vec![Vec3::ZERO; n],
@@ -201,6 +208,11 @@ impl NewtonWorkspace {
             pre.since_refresh = 0;
         }
         self.pre.since_refresh += 1;
+        if let Some(m) = &mut self.pre.matrix {
+            let h = &self.hessian;
+            let mass = |i: usize| h.mass[i] * h.inv_h2;
+            m.assemble((&h.tets, &h.b), (&h.evals, live), mass, true, parallel);
+        }
         let mut first_norm = None;
         for _ in 0..self.params.iterations {
             self.hessian.gather_gradient(
@@ -225,14 +237,26 @@ impl NewtonWorkspace {
                 *r = -*g;
             }
             let (hessian, pre) = (&mut self.hessian, &mut self.pre);
-            let cg = pcg(
-                &self.rhs,
-                &mut self.direction,
-                self.params.cg_iterations,
-                self.params.cg_tolerance,
-                |p, out| hessian.apply(p, out, live, free, parallel),
-                |r, z| pre.apply(r, z, free, parallel),
-            );
+            let mut solve = |smooth: bool| {
+                pcg(
+                    &self.rhs,
+                    &mut self.direction,
+                    self.params.cg_iterations,
+                    self.params.cg_tolerance,
+                    |p, out| hessian.apply(p, out, live, free, parallel),
+                    |r, z| pre.apply(r, z, free, parallel, smooth),
+                )
+            };
+            let mut cg = solve(true);
+            if cg.negative_curvature
+                && cg.iterations == 1
+                && self.params.smoother != Smoother::Jacobi
+            {
+                // The Gauss–Seidel direction leads into the Hessian's indefinite part
+                // (after a tear): solve this iteration with block Jacobi.
+                report.cg_products += 1;
+                cg = solve(false);
+            }
             report.iterations += 1;
             report.cg_products += cg.iterations;
             report.negative_curvature += u32::from(cg.negative_curvature);
@@ -443,10 +467,16 @@ impl Hessian {
 }
 
 impl TwoLevel {
-    /// `z = D⁻¹ r + P A_c⁻¹ Pᵀ r` (additive two-level; zero at fixed nodes).
-    fn apply(&mut self, r: &[Vec3], z: &mut [Vec3], free: &[bool], parallel: bool) {
-        for i in 0..r.len() {
-            z[i] = self.diag_inv[i] * r[i];
+    /// `z = S r + P A_c⁻¹ Pᵀ r` (additive two-level; zero at fixed nodes), `S` one
+    /// symmetric Gauss–Seidel sweep where the smoother is `GaussSeidel` and `smooth`, else
+    /// block Jacobi `D⁻¹`.
+    fn apply(&mut self, r: &[Vec3], z: &mut [Vec3], free: &[bool], parallel: bool, smooth: bool) {
+        if let (Some(m), true) = (&self.matrix, smooth) {
+            m.symmetric_gauss_seidel(r, z, free);
+        } else {
+            for i in 0..r.len() {
+                z[i] = self.diag_inv[i] * r[i];
+            }
         }
         self.grid.restrict(r, &mut self.rhs, parallel);
         self.coarse.solve(&mut self.rhs);
@@ -650,6 +680,46 @@ mod tests {
         assert!(
             scale > 0.0 && err <= 1e-4 * scale,
             "tangents off by {err} of {scale}"
+        );
+    }
+
+    /// The assembled Hessian's product is the matrix-free one, on a deformed block with
+    /// some tets released.
+    #[test]
+    fn the_assembled_hessian_is_the_matrix_free_one() {
+        let (mesh, mut ws, free) = setup();
+        let n = mesh.node_count();
+        let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 7 != 2).collect();
+        let u = wobble(n, 1e-3);
+        // CG's directions vanish at fixed nodes.
+        let p: Vec<Vec3> = wobble(n + 5, 1.0)[5..]
+            .iter()
+            .zip(&free)
+            .map(|(w, f)| if *f { *w } else { Vec3::ZERO })
+            .collect();
+        ws.hessian.evaluate(&u, &u, &live, &free, false);
+        let mut want = vec![Vec3::ZERO; n];
+        ws.hessian.apply(&p, &mut want, &live, &free, false);
+        let h = &ws.hessian;
+        let mut m = BlockMatrix::new(n, &h.tets);
+        m.assemble(
+            (&h.tets, &h.b),
+            (&h.evals, &live),
+            |i| h.mass[i] * h.inv_h2,
+            false,
+            true,
+        );
+        let mut got = vec![Vec3::ZERO; n];
+        m.mul(&p, &mut got, &free);
+        let scale = want.iter().map(|v| v.length()).fold(0.0, f32::max);
+        let err = want
+            .iter()
+            .zip(&got)
+            .map(|(a, b)| (*a - *b).length())
+            .fold(0.0, f32::max);
+        assert!(
+            scale > 0.0 && err <= 1e-5 * scale,
+            "assembled off by {err} of {scale}"
         );
     }
 
