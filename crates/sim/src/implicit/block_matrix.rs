@@ -5,9 +5,12 @@
 
 use glam::{Mat3, Vec3};
 
+use super::block_lanes::{PAIRS, tet_blocks};
 use super::coarse_assembly::pair_block;
+use super::product_lanes::{RestLanes, TangentLanes};
 use super::rest_tet::RestTet;
 use super::tet_evals::TetEvals;
+use crate::xpbd::lanes::LANES;
 
 /// A block-sparse symmetric matrix on the mesh's node graph, rows by node, columns
 /// sorted, the diagonal included.
@@ -26,6 +29,12 @@ pub struct BlockMatrix {
 /// Partial sums of an assembly: a fixed count, so the sum does not depend on the thread
 /// count.
 const PARTS: usize = 2;
+
+/// Part `k` of [`PARTS`] consecutive ranges covering `0..n`.
+fn part(k: usize, n: usize) -> std::ops::Range<usize> {
+    let per = n.div_ceil(PARTS).max(1);
+    (k * per).min(n)..((k + 1) * per).min(n)
+}
 
 impl BlockMatrix {
     /// The pattern of `tets` over `node_count` nodes, all blocks zero.
@@ -81,15 +90,22 @@ impl BlockMatrix {
         definite: bool,
         parallel: bool,
     ) {
-        let per_part = tets.len().div_ceil(PARTS).max(1);
         let mut parts = std::mem::take(&mut self.parts);
         parts.resize_with(PARTS, Vec::new);
         let sum_part = |(k, out): (usize, &mut Vec<Mat3>)| {
             out.clear();
             out.resize(self.cols.len(), Mat3::ZERO);
-            let range = (k * per_part).min(tets.len())..((k + 1) * per_part).min(tets.len());
-            for t in range.filter(|&t| live[t]) {
-                self.add_tet(out, t, (tets[t].volume, &b[t]), evals, definite);
+            match evals {
+                TetEvals::Lanes { rest, tangents, .. } => {
+                    for c in part(k, rest.len()) {
+                        self.add_chunk(out, c, (&rest[c], &tangents[c]), live, definite);
+                    }
+                }
+                TetEvals::Scalar(_) => {
+                    for t in part(k, tets.len()).filter(|&t| live[t]) {
+                        self.add_tet(out, t, (tets[t].volume, &b[t]), evals, definite);
+                    }
+                }
             }
         };
         if parallel {
@@ -106,6 +122,35 @@ impl BlockMatrix {
             let d = self.diagonal_slot(i);
             self.blocks[d] += Mat3::IDENTITY * mass_over_h2(i);
             self.d_inv[i] = self.blocks[d].inverse();
+        }
+    }
+
+    /// Add the blocks of chunk `c`'s live tets into `out` (ten computed in lanes, the other
+    /// six their transposes).
+    #[inline]
+    fn add_chunk(
+        &self,
+        out: &mut [Mat3],
+        c: usize,
+        (rest, tan): (&RestLanes, &TangentLanes),
+        live: &[bool],
+        definite: bool,
+    ) {
+        let blocks = tet_blocks(rest, tan, definite);
+        for k in (0..rest.count).filter(|&k| live[c * LANES + k]) {
+            let slots = &self.tet_slots[c * LANES + k];
+            for (e, &(a, b)) in blocks.iter().zip(PAIRS.iter()) {
+                // Row-major entries: these are the transpose's columns.
+                let m = Mat3::from_cols(
+                    Vec3::new(e[0][k], e[1][k], e[2][k]),
+                    Vec3::new(e[3][k], e[4][k], e[5][k]),
+                    Vec3::new(e[6][k], e[7][k], e[8][k]),
+                );
+                out[slots[4 * a + b] as usize] += m.transpose();
+                if a != b {
+                    out[slots[4 * b + a] as usize] += m;
+                }
+            }
         }
     }
 

@@ -4,6 +4,7 @@
 //! Cholesky-factorised Galerkin coarse grid). The tet solver ([`crate::xpbd::Solver`]) drives them when
 //! `solver.scheme` is `Newton`.
 
+mod block_lanes;
 mod block_matrix;
 mod coarse_assembly;
 mod coarse_grid;

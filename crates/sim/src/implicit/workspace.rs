@@ -496,6 +496,11 @@ mod tests {
     use crate::xpbd::lanes::LANES;
 
     fn setup() -> (TetMesh, NewtonWorkspace, Vec<bool>) {
+        setup_with(false)
+    }
+
+    /// A 4 × 2 × 1 cm block pinned at x = 0, its product tet by tet or (`lanes`) in lanes.
+    fn setup_with(lanes: bool) -> (TetMesh, NewtonWorkspace, Vec<bool>) {
         let raw = block(
             Vec3::ZERO,
             Vec3::new(0.04, 0.02, 0.01),
@@ -513,7 +518,7 @@ mod tests {
             &mass,
             &free,
             lame,
-            (1.0 / 60.0, false),
+            (1.0 / 60.0, lanes),
             NewtonParams::default(),
         )
         .unwrap();
@@ -684,43 +689,57 @@ mod tests {
     }
 
     /// The assembled Hessian's product is the matrix-free one, on a deformed block with
-    /// some tets released.
+    /// some tets released, assembled tet by tet and in lanes; and the definite form
+    /// assembles alike both ways on a block crushed past `J_MIN`.
     #[test]
     fn the_assembled_hessian_is_the_matrix_free_one() {
-        let (mesh, mut ws, free) = setup();
-        let n = mesh.node_count();
-        let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 7 != 2).collect();
-        let u = wobble(n, 1e-3);
-        // CG's directions vanish at fixed nodes.
-        let p: Vec<Vec3> = wobble(n + 5, 1.0)[5..]
-            .iter()
-            .zip(&free)
-            .map(|(w, f)| if *f { *w } else { Vec3::ZERO })
-            .collect();
-        ws.hessian.evaluate(&u, &u, &live, &free, false);
-        let mut want = vec![Vec3::ZERO; n];
-        ws.hessian.apply(&p, &mut want, &live, &free, false);
-        let h = &ws.hessian;
-        let mut m = BlockMatrix::new(n, &h.tets);
-        m.assemble(
-            (&h.tets, &h.b),
-            (&h.evals, &live),
-            |i| h.mass[i] * h.inv_h2,
-            false,
-            true,
-        );
-        let mut got = vec![Vec3::ZERO; n];
-        m.mul(&p, &mut got, &free);
-        let scale = want.iter().map(|v| v.length()).fold(0.0, f32::max);
-        let err = want
-            .iter()
-            .zip(&got)
-            .map(|(a, b)| (*a - *b).length())
-            .fold(0.0, f32::max);
+        let mut definite = Vec::new();
+        for lanes in [false, true] {
+            let (mesh, mut ws, free) = setup_with(lanes);
+            let n = mesh.node_count();
+            let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 7 != 2).collect();
+            // CG's directions vanish at fixed nodes.
+            let p: Vec<Vec3> = wobble(n + 5, 1.0)[5..]
+                .iter()
+                .zip(&free)
+                .map(|(w, f)| if *f { *w } else { Vec3::ZERO })
+                .collect();
+            let mut assembled = |u: &[Vec3], exact: bool| {
+                ws.hessian.evaluate(u, u, &live, &free, false);
+                let mut want = vec![Vec3::ZERO; n];
+                ws.hessian.apply(&p, &mut want, &live, &free, false);
+                let h = &ws.hessian;
+                let mut m = BlockMatrix::new(n, &h.tets);
+                let mass = |i: usize| h.mass[i] * h.inv_h2;
+                m.assemble((&h.tets, &h.b), (&h.evals, &live), mass, !exact, true);
+                let mut got = vec![Vec3::ZERO; n];
+                m.mul(&p, &mut got, &free);
+                (want, got)
+            };
+            let (want, got) = assembled(&wobble(n, 1e-3), true);
+            let (err, scale) = worst(&want, &got);
+            assert!(
+                scale > 0.0 && err <= 1e-5 * scale,
+                "lanes {lanes}: assembled off by {err} of {scale}"
+            );
+            definite.push(assembled(&wobble(n, 4e-3), false).1);
+        }
+        let (err, scale) = worst(&definite[0], &definite[1]);
         assert!(
-            scale > 0.0 && err <= 1e-5 * scale,
-            "assembled off by {err} of {scale}"
+            scale > 0.0 && err <= 1e-4 * scale,
+            "definite, lanes against tet by tet: off by {err} of {scale}"
         );
+    }
+
+    /// The largest difference of `a` and `b` and the largest length in `a`.
+    fn worst(a: &[Vec3], b: &[Vec3]) -> (f32, f32) {
+        let scale = a.iter().map(|v| v.length()).fold(0.0, f32::max);
+        let err = a
+            .iter()
+            .zip(b)
+            .map(|(p, q)| (*p - *q).length())
+            .fold(0.0, f32::max);
+        (err, scale)
     }
 
     /// `∇²G p` against central differences of `∇G`, and positive curvature near rest.
