@@ -1,9 +1,10 @@
 //! The implicit scheme on the GPU (issue 31, item 4) against the CPU's, on lavapipe in CI:
 //! a cantilever that bends and a bar that tears give the same positions to within a
-//! fraction of their motion and the same tear, and rest stays exactly at rest. Both solve
-//! each step close to convergence, so the bounds are on the converged answer, not on
-//! iterate-by-iterate identity (the device sums in another order, in f32, and applies the
-//! coarse level as a dense inverse).
+//! fraction of their motion, the same tear and about the same conjugate-gradient work,
+//! and rest stays exactly at rest. Both solve each step close to convergence, so the
+//! bounds are on the converged answer, not on iterate-by-iterate identity (the device
+//! sums in another order, in f32, and applies the coarse level as a dense inverse; on
+//! lavapipe the two in fact agree to 1e-6 of the motion before a tear).
 //!
 //! Needs a wgpu adapter; without one the tests print why and pass, unless the GPU is
 //! required (`INCISE_REQUIRE_GPU=1`, or `CI` set with it unset; crates/test-gate).
@@ -17,7 +18,8 @@ use incise_sim::implicit::{CoarseRefresh, NewtonParams, Scheme};
 use incise_sim::{Solver, SolverParams};
 
 /// Close enough to convergence that the CPU's and the device's rounding, not their
-/// stopping points, set the gap.
+/// stopping points, set the gap; the coarse level refreshed every other step, so both
+/// refreshes and releases reach the device's coarse inverse.
 const CONVERGED: NewtonParams = NewtonParams {
     steps: 1,
     iterations: 8,
@@ -28,9 +30,19 @@ const CONVERGED: NewtonParams = NewtonParams {
     coarse_refresh: CoarseRefresh::Steps(2),
 };
 
+/// Positions within this fraction of the motion (the tip's sag, the bar's pull) of each
+/// other while the body is whole: a thousand times what lavapipe shows, room for another
+/// device's rounding and for the CPU's preconditioner to change, far below what a wrong
+/// Hessian or gradient leaves.
+const WHOLE: f32 = 1e-3;
+
+/// The GPU's conjugate-gradient products over the run within this fraction of the CPU's
+/// (lavapipe: within 1 % on both bodies).
+const PRODUCTS: f64 = 0.2;
+
 /// A 10 × 2 × 2 cm cantilever of soft tissue (E = 100 kPa) pinned at x = 0, falling
-/// under gravity and bending about a fifth of its length: the CPU and the device end each
-/// frame within 0.1 % of the tip's sag of each other.
+/// under gravity and swinging to a sag of 12 % of its length: the CPU and the device end
+/// every frame within [`WHOLE`] of the tip's sag of each other, with about the same work.
 #[test]
 fn a_bending_cantilever_matches_the_cpu() {
     let Some(ctx) = common::gpu_context() else {
@@ -57,26 +69,36 @@ fn a_bending_cantilever_matches_the_cpu() {
     };
     let mut cpu = beam();
     let mut gpu = GpuSolver::new(beam(), &ctx).expect("upload");
-    let t0 = std::time::Instant::now();
-    for frame in 0..30 {
+    let (mut cpu_products, mut gpu_products) = (0u64, 0u64);
+    let mut sag = 0.0;
+    for frame in 0..20 {
         let a = cpu.step_frame().unwrap();
         let b = gpu.step_frame().unwrap();
-        let sag = common::max_displacement(&cpu);
+        cpu_products += a.cg_products as u64;
+        gpu_products += b.cg_products as u64;
+        sag = common::max_displacement(&cpu);
         let gap = common::worst_gap(cpu.positions(), gpu.host().positions());
-        println!(
-            "frame {frame}: sag {sag:.5} m, gap {gap:e} m ({:.2e}), products {} / {}, passes {}",
-            gap / sag.max(1e-9),
-            a.cg_products,
-            b.cg_products,
-            b.passes
+        assert!(
+            gap <= WHOLE * sag,
+            "frame {frame}: positions {gap:e} m apart at a sag of {sag:e} m"
         );
+        assert!(b.passes > 0, "frame {frame}: no dispatches counted");
     }
-    println!("{:?}", t0.elapsed());
+    assert!(sag > 0.01, "the beam bends: sag {sag} m");
+    let report = gpu.newton_report().expect("the device ran Newton");
+    assert!(report.iterations >= 1, "{report:?}");
+    let off = (gpu_products as f64 / cpu_products as f64 - 1.0).abs();
+    assert!(
+        off <= PRODUCTS,
+        "products {gpu_products} on the device against {cpu_products} on the CPU"
+    );
 }
 
-/// The tearing bar of the XPBD tests under Newton in steps of the release interval: the
-/// first release in the same frame on both, the released tets within 5 % of each other,
-/// and the positions before the tear within 0.1 % of the pull.
+/// The tearing bar of the XPBD tests under Newton in steps of the release interval
+/// (tests/implicit_scheme.rs): the first release in the same frame, the released tets
+/// within 2 % of each other every frame (lavapipe: the same tets), the positions within
+/// [`WHOLE`] of the pull before the tear and 5 % after it (flaps hanging from a few
+/// nodes amplify rounding, as in tests/gpu_parity.rs), and about the same work.
 #[test]
 fn a_tearing_bar_matches_the_cpu() {
     let Some(ctx) = common::gpu_context() else {
@@ -93,26 +115,52 @@ fn a_tearing_bar_matches_the_cpu() {
     };
     let mut cpu = bar();
     let mut gpu = GpuSolver::new(bar(), &ctx).expect("upload");
-    let t0 = std::time::Instant::now();
-    for frame in 0..60 {
+    let (mut cpu_products, mut gpu_products) = (0u64, 0u64);
+    let mut first = (None, None);
+    // The first release comes in frame 7, the cascade is over by frame 18.
+    for frame in 0..16 {
         let a = cpu.step_frame().unwrap();
         let b = gpu.step_frame().unwrap();
+        cpu_products += a.cg_products as u64;
+        gpu_products += b.cg_products as u64;
+        for (f, st) in [(&mut first.0, &a), (&mut first.1, &b)] {
+            if st.released_total > 0 && f.is_none() {
+                *f = Some(frame);
+            }
+        }
         let pull = common::max_displacement(&cpu);
         let gap = common::worst_gap(cpu.positions(), gpu.host().positions());
-        println!(
-            "frame {frame}: pull {pull:.5} m, gap {gap:e} m ({:.2e}), released {} / {}, products {} / {}, passes {}",
-            gap / pull.max(1e-9),
+        let bound = if a.released_total == 0 { WHOLE } else { 0.05 };
+        assert!(
+            gap <= bound * pull,
+            "frame {frame}: positions {gap:e} m apart at a pull of {pull:e} m"
+        );
+        let (x, y) = (cpu.cut().live(), gpu.host().cut().live());
+        let differ = x.iter().zip(y).filter(|(p, q)| p != q).count();
+        assert!(
+            differ as f64 <= 0.02 * a.released_total as f64,
+            "frame {frame}: {differ} tets live on one side only ({} released on the CPU, {} on the device)",
             a.released_total,
-            b.released_total,
-            a.cg_products,
-            b.cg_products,
-            b.passes
+            b.released_total
         );
     }
-    println!("{:?}", t0.elapsed());
+    assert!(
+        first.0.is_some() && first.0 == first.1,
+        "first release in frame {:?} on the CPU, {:?} on the device",
+        first.0,
+        first.1
+    );
+    assert!(cpu.cut().released_count() > 400, "the bar tears through");
+    let off = (gpu_products as f64 / cpu_products as f64 - 1.0).abs();
+    assert!(
+        off <= PRODUCTS,
+        "products {gpu_products} on the device against {cpu_products} on the CPU"
+    );
 }
 
-/// Without loads a body at rest stays exactly at rest under Newton on the device.
+/// Without loads a body at rest stays exactly at rest under Newton on the device (the
+/// gradient is exactly zero there, so no iteration runs), the coarse level refreshed
+/// every step.
 #[test]
 fn rest_stays_exactly_at_rest_on_the_gpu() {
     let Some(ctx) = common::gpu_context() else {

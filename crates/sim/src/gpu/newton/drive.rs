@@ -9,7 +9,7 @@
 use glam::Vec3;
 
 use super::GpuNewton;
-use super::layout::{ALPHA_OFFSET, S_NEG, S_PRODUCTS, S_STOP, V_TRIAL};
+use super::layout::{ALPHA_OFFSET, S_FIRST, S_NEG, S_PRODUCTS, S_STOP, V_TRIAL};
 use crate::gpu::GpuError;
 use crate::implicit::NewtonReport;
 
@@ -17,10 +17,12 @@ use crate::implicit::NewtonReport;
 const ARMIJO: f64 = 1e-4;
 /// Most halvings of a Newton step before the step is abandoned (the CPU's).
 const MAX_HALVINGS: u32 = 8;
-/// Conjugate-gradient iterations recorded per submission; the host reads whether the
-/// solve has stopped between submissions (a stopped solve's remaining dispatches return
-/// at once).
-pub(crate) const CG_BATCH: u32 = 6;
+/// Conjugate-gradient iterations recorded per submission after the first (which records
+/// as many as the last solve took); the host reads whether the solve has stopped between
+/// submissions (a stopped solve's remaining dispatches return at once).
+pub(crate) const CG_BATCH: u32 = 4;
+/// Most iterations of a first submission.
+const CG_FIRST_MAX: u32 = 32;
 
 /// The device, its queue and the node buffers the step reads and writes.
 pub(crate) struct OnDevice<'a> {
@@ -143,27 +145,35 @@ impl GpuNewton {
                 (&k.precondition_init, &b.cg, ng),
             ],
         );
-        let iteration: [Dispatch<'_>; 6] = [
-            (&k.begin, &b.cg, 1),
+        let iteration: [Dispatch<'_>; 5] = [
             (&k.product, &b.tets, tg),
             (&k.gather_product, &b.nodes, ng),
             (&k.step_restrict, &b.cg, 1),
             (&k.coarse_solve, &b.cg, rg),
             (&k.update, &b.cg, ng),
         ];
-        let batch: Vec<Dispatch<'_>> = (0..CG_BATCH).flat_map(|_| iteration).collect();
+        let max = self.params.cg_iterations;
+        let mut batch = self.cg_hint.clamp(1, CG_FIRST_MAX.min(max));
         let mut dispatches = 0;
         let at = self.scratch.state();
+        let tol2 = (self.params.cg_tolerance as f64).powi(2);
         loop {
-            dispatches += record(&mut enc, &batch);
+            let list: Vec<Dispatch<'_>> = (0..batch).flat_map(|_| iteration).collect();
+            dispatches += record(&mut enc, &list);
             let (s, _) = self.submit_read(dev, enc, false)?;
             enc = encoder(dev);
             let products = s[at + S_PRODUCTS] as u32;
             let negative = s[at + S_NEG] != 0.0;
-            if s[at + S_STOP] != 0.0 || negative || products >= self.params.cg_iterations {
+            // The device stops at the next product's start; the host sees the same test
+            // on the residual the last update left, and records no more.
+            let rz: f64 = s[self.scratch.rz()].iter().map(|&v| v as f64).sum();
+            let converged = rz <= tol2 * s[at + S_FIRST] as f64;
+            if s[at + S_STOP] != 0.0 || negative || converged || products >= max {
                 self.dispatches += dispatches;
+                self.cg_hint = products;
                 return Ok((enc, products, negative));
             }
+            batch = CG_BATCH.min(max - products).max(1);
         }
     }
 

@@ -72,7 +72,6 @@ pub(crate) struct NewtonKernels {
     pub restrict_init: wgpu::ComputePipeline,
     pub coarse_solve: wgpu::ComputePipeline,
     pub precondition_init: wgpu::ComputePipeline,
-    pub begin: wgpu::ComputePipeline,
     pub step_restrict: wgpu::ComputePipeline,
     pub update: wgpu::ComputePipeline,
 }
@@ -145,7 +144,6 @@ impl NewtonKernels {
             restrict_init: pipeline(&cg, &cg_layout, "restrict_init"),
             coarse_solve: pipeline(&cg, &cg_layout, "coarse_solve"),
             precondition_init: pipeline(&cg, &cg_layout, "precondition_init"),
-            begin: pipeline(&cg, &cg_layout, "begin"),
             step_restrict: pipeline(&cg, &cg_layout, "step_restrict"),
             update: pipeline(&cg, &cg_layout, "update"),
             tets_layout,

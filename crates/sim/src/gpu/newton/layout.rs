@@ -53,6 +53,8 @@ pub(crate) const S_STOP: usize = 0;
 pub(crate) const S_NEG: usize = 1;
 /// Products spent.
 pub(crate) const S_PRODUCTS: usize = 2;
+/// The first `r · z`.
+pub(crate) const S_FIRST: usize = 3;
 /// Words of state.
 pub(crate) const STATE_WORDS: usize = 8;
 
@@ -68,6 +70,10 @@ impl Scratch {
     /// `|∇G|²` partials.
     pub fn grad2(&self) -> std::ops::Range<usize> {
         self.node(1)
+    }
+    /// `r · z` partials (the last preconditioned residual of the solve).
+    pub fn rz(&self) -> std::ops::Range<usize> {
+        self.node(2)
     }
     /// `∇G · d` partials.
     pub fn slope(&self) -> std::ops::Range<usize> {
@@ -109,6 +115,7 @@ mod tests {
             ("S_STOP", S_STOP),
             ("S_NEG", S_NEG),
             ("S_PRODUCTS", S_PRODUCTS),
+            ("S_FIRST", S_FIRST),
         ] {
             let line = format!("const {name}: u32 = {value}u;");
             assert!(src.contains(&line), "newton_common.wgsl lacks `{line}`");

@@ -79,6 +79,9 @@ pub(crate) struct GpuNewton {
     pub last: NewtonReport,
     /// Dispatches recorded since the caller last took the count.
     pub dispatches: u32,
+    /// Products of the last conjugate-gradient solve: how many iterations the next one
+    /// records before its first readback.
+    cg_hint: u32,
 }
 
 fn storage(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
@@ -281,6 +284,7 @@ impl GpuNewton {
             node_count: n,
             last: NewtonReport::default(),
             dispatches: 0,
+            cg_hint: 8,
         }))
     }
 

@@ -2,10 +2,10 @@
 // at non-positive curvature as in Nocedal & Wright 2006, Alg. 7.1), preconditioned by
 // z = D^-1 r + P A_c^-1 P^T r: block Jacobi plus the coarse grid, whose inverse the host
 // computes from its Cholesky factor and uploads (docs/physics-notes.md, "The implicit
-// scheme on the GPU"). The solve's scalars live in `scratch`: `begin` and `step_restrict` run as
-// one workgroup and decide (beta and the stop; alpha and the curvature), the other kernels
-// read what they wrote, so every thread uses the same values and nothing is read back per
-// iteration. CPU twin: crates/sim/src/implicit/pcg.rs and TwoLevel::apply in
+// scheme on the GPU"). The solve's scalars live in `scratch`: `product` (newton_tets.wgsl)
+// decides beta and the stop, `step_restrict` (one workgroup) alpha and the curvature; the
+// other kernels read what they wrote, so every thread uses the same values and nothing is
+// read back per iteration. CPU twin: crates/sim/src/implicit/pcg.rs and TwoLevel::apply in
 // implicit/workspace.rs.
 //
 // coarse_map: per fine node 8 coarse ids then their 8 weights (f32 bits); from
@@ -127,31 +127,6 @@ fn precondition_init(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(loc
     if (l == 0u) {
         scratch[at_rz() + wg.x] = total;
     }
-}
-
-// An iteration's start (one workgroup): r . z reduced; stop at the product budget, at
-// r . z <= 0 or below tol^2 of the first; else beta = r.z / the last r.z, and the product
-// is counted.
-@compute @workgroup_size(256)
-fn begin(@builtin(local_invocation_index) l: u32) {
-    let rz = sum_partials(l, at_rz(), NW.node_groups);
-    let st = at_state();
-    if (l != 0u || stopped()) {
-        return;
-    }
-    let it = scratch[st + S_PRODUCTS];
-    var first = scratch[st + S_FIRST];
-    if (it == 0.0) {
-        first = max(rz, TINY);
-        scratch[st + S_FIRST] = first;
-    }
-    if (it >= f32(NW.max_products) || !(rz > 0.0) || rz <= NW.tol2 * first) {
-        scratch[st + S_STOP] = 1.0;
-        return;
-    }
-    scratch[st + S_BETA] = select(rz / scratch[st + S_RZ], 0.0, it == 0.0);
-    scratch[st + S_RZ] = rz;
-    scratch[st + S_PRODUCTS] = it + 1.0;
 }
 
 // After the product (one workgroup): p . A p reduced; at p . A p <= 0 the solve stops

@@ -57,6 +57,7 @@ const S_FIRST: u32 = 3u;    // r0.z0
 const S_RZ: u32 = 4u;       // r.z of the current iteration
 const S_BETA: u32 = 5u;
 const S_ALPHA: u32 = 6u;
+const S_RZ_NEXT: u32 = 7u; // r.z as `product` reduced it, until `gather_product` books it
 
 // f64::MIN_POSITIVE's role in the CPU's first r.z (no division by zero).
 const TINY: f32 = 1.17549435e-38;
@@ -76,6 +77,16 @@ fn sum64(l: u32, v: f32) -> f32 {
     let total = red[0];
     workgroupBarrier();
     return total;
+}
+
+// The sum of `count` partial sums from `at`, by a 64-thread workgroup; every thread gets
+// it (each workgroup of a dispatch sums them in the same order: the same value).
+fn sum_partials64(l: u32, at: u32, count: u32) -> f32 {
+    var v = 0.0;
+    for (var k = l; k < count; k += 64u) {
+        v += scratch[at + k];
+    }
+    return sum64(l, v);
 }
 
 // The 3 x 3 symmetric block stored as (xx yy zz xy), (xz yz).

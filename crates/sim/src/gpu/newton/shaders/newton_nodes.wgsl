@@ -113,13 +113,18 @@ fn trial(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocatio
 
 // The conjugate gradient's product, per node: p = z + beta p (stored), then
 // A p = M/h^2 p + the sum of the corner forces (zero at fixed nodes), and partial sums of
-// p . A p.
+// p . A p; workgroup 0 books the product and its r . z.
 @compute @workgroup_size(64)
 fn gather_product(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) l: u32, @builtin(workgroup_id) wg: vec3<u32>) {
     let i = gid.x;
     let st = at_state();
     var pap = 0.0;
-    if (i < NW.node_count && scratch[st + S_STOP] == 0.0 && scratch[st + S_NEG] == 0.0) {
+    let running = scratch[st + S_STOP] == 0.0 && scratch[st + S_NEG] == 0.0;
+    if (running && wg.x == 0u && l == 0u) {
+        scratch[st + S_RZ] = scratch[st + S_RZ_NEXT];
+        scratch[st + S_PRODUCTS] = scratch[st + S_PRODUCTS] + 1.0;
+    }
+    if (i < NW.node_count && running) {
         let p = vecs[vi(V_Z, i)].xyz + scratch[st + S_BETA] * vecs[vi(V_P, i)].xyz;
         vecs[vi(V_P, i)] = vec4<f32>(p, 0.0);
         var ap = vec3<f32>(0.0);

@@ -80,13 +80,39 @@ fn energy(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocati
     }
 }
 
-// The conjugate gradient's product, per tet: with p = z + beta p_old at its corners (the
-// update `gather_product` stores), the corner forces V dP[dF(p)] b_a.
+// A conjugate-gradient iteration's start and its product, per tet. Every workgroup
+// reduces r . z (the same sum) and decides as the CPU's loop head does: stop at the
+// product budget, at r . z <= 0 or below tol^2 of the first; else beta = r.z / the last
+// r.z (workgroup 0 stores the decision for the later kernels). Then, with
+// p = z + beta p_old at its corners (the update `gather_product` stores), the corner
+// forces V dP[dF(p)] b_a.
 @compute @workgroup_size(64)
-fn product(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let slot = gid.x;
+fn product(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) l: u32, @builtin(workgroup_id) wg: vec3<u32>) {
+    let rz = sum_partials64(l, at_rz(), NW.node_groups);
     let st = at_state();
-    if (slot >= NW.slot_count || scratch[st + S_STOP] != 0.0 || scratch[st + S_NEG] != 0.0) {
+    if (scratch[st + S_STOP] != 0.0 || scratch[st + S_NEG] != 0.0) {
+        return;
+    }
+    let it = scratch[st + S_PRODUCTS];
+    var first = scratch[st + S_FIRST];
+    if (it == 0.0) {
+        first = max(rz, TINY);
+    }
+    let lead = wg.x == 0u && l == 0u;
+    if (it >= f32(NW.max_products) || !(rz > 0.0) || rz <= NW.tol2 * first) {
+        if (lead) {
+            scratch[st + S_STOP] = 1.0;
+        }
+        return;
+    }
+    let beta = select(rz / scratch[st + S_RZ], 0.0, it == 0.0);
+    if (lead) {
+        scratch[st + S_BETA] = beta;
+        scratch[st + S_RZ_NEXT] = rz;
+        scratch[st + S_FIRST] = first;
+    }
+    let slot = gid.x;
+    if (slot >= NW.slot_count) {
         return;
     }
     let o = slot * TET_STRIDE;
@@ -96,7 +122,6 @@ fn product(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         return;
     }
-    let beta = scratch[st + S_BETA];
     let idx = tets[slot];
     let r = rest[slot];
     let d0 = vecs[vi(V_Z, idx.x)].xyz + beta * vecs[vi(V_P, idx.x)].xyz;
