@@ -71,12 +71,6 @@ impl GpuSolver {
             };
             enc = newton.solve_step(&dev, &live, enc)?;
             let r = newton.last;
-            if std::env::var_os("INCISE_TRACE_NEWTON").is_some() {
-                eprintln!(
-                    "TRACE step {s}: {r:?}, dispatches so far {}",
-                    newton.dispatches
-                );
-            }
             self.host.implicit_cost.0 += r.cg_products;
             self.host.implicit_cost.1 += u32::from(r.coarse_refreshed);
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
