@@ -428,8 +428,7 @@ fn the_implicit_scheme_runs_on_either_device_and_checks_its_settings() {
         let o = run("config/intestine_pull_newton.ron", "gpu", "gpu");
         assert!(o.status.success(), "{}", text(&o.stderr));
         let r: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(dir.join("gpu/report.json")).unwrap())
-                .unwrap();
+            serde_json::from_slice(&std::fs::read(dir.join("gpu/report.json")).unwrap()).unwrap();
         assert!(r["device"].as_str().unwrap().starts_with("gpu"), "{r}");
         assert_eq!(r["frames"].as_array().unwrap().len(), 1, "{r}");
     }
