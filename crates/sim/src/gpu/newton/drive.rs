@@ -243,6 +243,8 @@ impl GpuNewton {
     }
 
     /// `G`, `|∇G|²` and the slope from the partial sums of a readback.
+    // PHYSICS.md §1.2's energy plus the inertia: G = Σ V Ψ + 1/(2h²) Σ m |u − y|²
+    // (crates/sim/src/implicit/workspace.rs).
     fn sums(&self, s: &[f32]) -> Sums {
         let sum = |r: std::ops::Range<usize>| s[r].iter().map(|&v| v as f64).sum::<f64>();
         let sc = &self.scratch;

@@ -17,7 +17,8 @@ fn is_free(i: u32) -> bool {
     return kind[i] == KIND_FREE;
 }
 
-// The step's start, after the prediction: y = u + h v + h^2 g (what `pos` holds), and the
+// The step's start, after the prediction (PHYSICS.md §1.2's small-steps loop, one implicit
+// step long): y = u + h v + h^2 g (what `pos` holds), and the
 // first iterate u + h v, without this step's h^2 g (docs/physics-notes.md, "The initial
 // iterate").
 @compute @workgroup_size(64)
