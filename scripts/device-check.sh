@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One short check for a machine with a real GPU (issue 17): the GPU tests, the realtime
 # benchmark of the default scene (34k tets) on the GPU (a dispatch per colour, and the
-# partitioned order's dispatch per phase) and the CPU, the solver benchmark
+# partitioned order's dispatch per phase) and the CPU, the same organ on the implicit
+# scheme on the GPU (issue 31: its dispatches a frame), the solver benchmark
 # up to ≥ 1M tets on the GPU, and a CPU/GPU parity run, written as one JSON object to
 # ${OUT:-.}/device-check.json (stdout and stderr of each step beside it). Under 5 minutes
 # on a datacentre GPU once built; the build itself is not timed.
@@ -31,9 +32,10 @@ step() {
     echo "\"$name\": {\"rc\": $rc, \"seconds\": $((SECONDS - t0))}" >"$out/$name.rc"
 }
 
-step gpu_tests cargo test --release --locked -p incise-sim --test gpu_parity --test gpu_validation
+step gpu_tests cargo test --release --locked -p incise-sim --test gpu_parity --test gpu_validation --test gpu_newton
 step realtime_gpu "$bin" bench realtime --device gpu --frames 60 --json
 step realtime_gpu_blocks "$bin" bench realtime --device gpu --cpu-sweep blocks --frames 60 --json
+step realtime_gpu_newton "$bin" bench realtime --scene config/intestine_pull_newton.ron --device gpu --frames 60 --json
 step realtime_cpu "$bin" bench realtime --device cpu --frames 10 --json
 step scaling_gpu "$bin" bench solver --device gpu --case intestine --scaling --frames 5 --json
 step parity "$bin" compare config/intestine_pull.ron --frames 20 --json
@@ -46,11 +48,12 @@ step parity "$bin" compare config/intestine_pull.ron --frames 20 --json
     cat "$out"/gpu_tests.rc; echo ","
     cat "$out"/realtime_gpu.rc; echo ","
     cat "$out"/realtime_gpu_blocks.rc; echo ","
+    cat "$out"/realtime_gpu_newton.rc; echo ","
     cat "$out"/realtime_cpu.rc; echo ","
     cat "$out"/scaling_gpu.rc; echo ","
     cat "$out"/parity.rc
     echo "},"
-    for s in realtime_gpu realtime_gpu_blocks realtime_cpu scaling_gpu parity; do
+    for s in realtime_gpu realtime_gpu_blocks realtime_gpu_newton realtime_cpu scaling_gpu parity; do
         echo "\"$s\": $(if [ -s "$out/$s.out" ] && head -c1 "$out/$s.out" | grep -q '[{[]'; then cat "$out/$s.out"; else echo null; fi),"
     done
     echo "\"gpu_tests_summary\": \"$(grep -E '^test result' "$out/gpu_tests.out" | tr '\n' ' ')\""

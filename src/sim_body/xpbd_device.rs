@@ -5,7 +5,6 @@ use anyhow::{Context, Result};
 use clap::ValueEnum;
 use incise_sim::Solver;
 use incise_sim::gpu::{GpuContext, GpuSolver};
-use incise_sim::implicit::Scheme;
 use incise_sim::xpbd::{FrameStats, SolverError};
 
 /// Where the solver runs.
@@ -87,12 +86,6 @@ impl Body {
             DeviceChoice::Gpu => {
                 let ctx = context()?;
                 Ok(Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?)))
-            }
-            DeviceChoice::Auto if solver.params().scheme != Scheme::Xpbd => {
-                notice(
-                    "--device auto: cpu, because the scene's solver.scheme (Newton) runs on the CPU only",
-                );
-                Ok(Body::Cpu(Box::new(solver)))
             }
             DeviceChoice::Auto => match context() {
                 Ok(ctx) => {

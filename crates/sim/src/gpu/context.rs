@@ -37,11 +37,19 @@ pub enum GpuError {
         /// Bytes allowed.
         limit: u64,
     },
-    /// The scene's scheme has no GPU kernels.
+    /// The implicit scheme's coarse level could not be built.
+    #[error(transparent)]
+    Coarse(#[from] crate::implicit::CoarseError),
+    /// The implicit scheme's coarse level is too fine for its dense inverse on the device.
     #[error(
-        "solver.scheme Newton runs on the CPU only (the GPU solver is XPBD's): use --device cpu, or scheme: Xpbd for the GPU"
+        "the implicit scheme's coarse level has {nodes} nodes; the GPU applies its inverse as a dense matrix and takes at most {max}: set a larger solver.scheme coarse_cell, or use --device cpu"
     )]
-    CpuOnlyScheme,
+    CoarseTooLarge {
+        /// Coarse nodes of the scene.
+        nodes: usize,
+        /// Most the device takes.
+        max: usize,
+    },
     /// Reading results back failed (device lost, out of memory).
     #[error("GPU readback failed: {0}")]
     Readback(String),

@@ -1,5 +1,10 @@
 //! `GpuSolver`: persistent device buffers and one command encoder per frame (all substeps,
-//! all colours, stress and release), with the CPU `Solver` as host mirror.
+//! all colours, stress and release), with the CPU `Solver` as host mirror. Under
+//! `scheme: Newton` a frame is the implicit steps of `gpu/newton/` instead of the
+//! substeps (`solver/newton_frame.rs`), with the same prediction, contact, velocity,
+//! stress and release kernels around them.
+
+mod newton_frame;
 
 use std::time::Instant;
 
@@ -10,6 +15,7 @@ use super::kernels::Kernels;
 use super::layout::{
     KIND_FREE, KIND_GRAB0, KIND_PINNED, KIND_RETIRED, Params, STEP_STRIDE, Step, TetRest,
 };
+use super::newton::{GpuNewton, Shared};
 use super::{GpuContext, GpuError};
 use crate::Solver;
 use crate::contact::{ContactTool, CutZone, PlacedTool, ToolPose};
@@ -111,6 +117,8 @@ pub struct GpuSolver {
     params: Params,
     tool_words: Vec<[f32; 4]>,
     fault: super::context::DeviceFault,
+    /// The implicit scheme's kernels and coarse level (`None` under XPBD).
+    newton: Option<GpuNewton>,
 }
 
 fn storage(
@@ -163,10 +171,10 @@ fn entries<'a>(list: &[&'a wgpu::Buffer]) -> Vec<wgpu::BindGroupEntry<'a>> {
 
 impl GpuSolver {
     /// Upload `host`'s state (mesh, rest data, colouring, pins, grabs) to the device.
-    pub fn new(host: Solver, ctx: &GpuContext) -> Result<Self, GpuError> {
-        if host.params.scheme != crate::implicit::Scheme::Xpbd {
-            return Err(GpuError::CpuOnlyScheme);
-        }
+    pub fn new(mut host: Solver, ctx: &GpuContext) -> Result<Self, GpuError> {
+        // The device keeps its own coarse level: the host's would be refactorised on every
+        // release for nothing (it is built again if the CPU takes over, `into_host`).
+        host.newton = None;
         let device = ctx.device.clone();
         let queue = ctx.queue.clone();
         let n = host.x.len();
@@ -218,8 +226,8 @@ impl GpuSolver {
             .collect();
         let p = &host.params;
         let params = params_of(&host);
-        // Step records: one per substep (prediction), then one per colour.
-        let substeps = p.substeps as usize;
+        // Step records: one per substep or implicit step (prediction), then one per colour.
+        let substeps = p.steps() as usize;
         let colours = host.color_ranges.len();
         let phases = host.plan.phases.len();
         let mut step_bytes = vec![0u8; (substeps + colours + phases) * STEP_STRIDE as usize];
@@ -453,7 +461,20 @@ impl GpuSolver {
             push: staging(&device, "read contact push", n as u64 * 16),
             near_edge: staging(&device, "read near edge", n as u64 * 4),
         };
-        let timestamps = ctx.timestamps.then(|| Timestamps {
+        let newton = GpuNewton::new(
+            &device,
+            &host,
+            Shared {
+                pos: &buf.pos,
+                tets: &buf.tets,
+                rest: &buf.rest,
+                live: &buf.live,
+                kind: &buf.kind,
+            },
+            (&ctx.info.name, ctx.max_binding),
+        )?;
+        // A Newton frame spans several submissions: no pass brackets it (no GPU timing).
+        let timestamps = (ctx.timestamps && newton.is_none()).then(|| Timestamps {
             queries: device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some("frame timestamps"),
                 ty: wgpu::QueryType::Timestamp,
@@ -483,6 +504,7 @@ impl GpuSolver {
             params,
             tool_words: Vec::new(),
             fault: ctx.fault.clone(),
+            newton,
         })
     }
 
@@ -537,6 +559,11 @@ impl GpuSolver {
         &self.host
     }
 
+    /// The implicit scheme's last step (`None` under XPBD).
+    pub fn newton_report(&self) -> Option<crate::implicit::NewtonReport> {
+        self.newton.as_ref().map(|n| n.last)
+    }
+
     /// Adapter name, backend and type.
     pub fn adapter(&self) -> &str {
         &self.adapter
@@ -582,7 +609,13 @@ impl GpuSolver {
             enc.clear_buffer(&self.buf.push, 0, None);
         }
 
-        self.host.passes = self.record_frame(&mut enc);
+        let mut enc = if self.newton.is_some() {
+            self.record_newton_frame(enc)
+                .map_err(|e| SolverError::Device(e.to_string()))?
+        } else {
+            self.host.passes = self.record_frame(&mut enc);
+            enc
+        };
         if with_tool {
             enc.copy_buffer_to_buffer(&self.buf.push, 0, &self.read.push, 0, n * 16);
             enc.copy_buffer_to_buffer(&self.buf.near_edge, 0, &self.read.near_edge, 0, n * 4);
@@ -640,6 +673,9 @@ impl GpuSolver {
             .collect();
         let ev = self.host.release(&mesh_tets);
         self.retire_on_device(&ev.retired_nodes);
+        if let Some(newton) = &mut self.newton {
+            newton.release(&self.queue, &ev.tets);
+        }
         if let Some(m) = &mut self.host.tool {
             m.from = m.to;
         }
@@ -655,8 +691,8 @@ impl GpuSolver {
         if grabs.is_empty() {
             return;
         }
-        let h = self.host.params.substep() as f64;
-        for s in 0..self.host.params.substeps as usize {
+        let h = self.host.params.step_length() as f64;
+        for s in 0..self.host.params.steps() as usize {
             let t = self.host.time + (s + 1) as f64 * h;
             for (g, grab) in grabs.iter().enumerate() {
                 let o = grab.offset_at(t);
@@ -675,7 +711,7 @@ impl GpuSolver {
     fn upload_tool(&mut self) {
         let params = params_of(&self.host);
         if let Some(motion) = &self.host.tool {
-            let n = self.host.params.substeps;
+            let n = self.host.params.steps();
             self.tool_words.clear();
             for k in 0..=n {
                 push_placed(&mut self.tool_words, &motion.placed_at(k, n));
@@ -946,7 +982,7 @@ impl GpuSolver {
 /// of the attached tool, if any).
 fn params_of(host: &Solver) -> Params {
     let p = &host.params;
-    let h = p.substep();
+    let h = p.step_length();
     let (sphere_count, box_count, friction) = host.tool.as_ref().map_or((0, 0, 0.0), |m| {
         (
             m.tool.spheres.len() as u32,

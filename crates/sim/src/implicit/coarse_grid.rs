@@ -102,6 +102,12 @@ impl CoarseGrid {
         }
     }
 
+    /// Per coarse node, the range of the second list holding its fine nodes and their
+    /// weights (the restriction's order; what the GPU's restriction reads).
+    pub(crate) fn transposed(&self) -> (&[u32], &[(u32, f32)]) {
+        (&self.transpose_offsets, &self.transpose)
+    }
+
     /// `z += P c`: coarse values interpolated onto the fine nodes.
     pub fn prolong_add(&self, c: &[f64], z: &mut [Vec3], parallel: bool) {
         let node = |(w, z): (&NodeWeights, &mut Vec3)| {

@@ -150,6 +150,19 @@ impl CoarseSystem {
             .solve_in_place(MatMut::from_column_major_slice_mut(b, n, 1));
     }
 
+    /// `A_c⁻¹` as a dense matrix (3 rows per coarse node; symmetric, so row- and
+    /// column-major alike), from the factor: what the GPU applies as a mat-vec.
+    pub(crate) fn dense_inverse(&self) -> Vec<f64> {
+        let n = self.col_ptr.len() - 1;
+        let mut m = vec![0.0; n * n];
+        for i in 0..n {
+            m[i * n + i] = 1.0;
+        }
+        self.factor
+            .solve_in_place(MatMut::from_column_major_slice_mut(&mut m, n, n));
+        m
+    }
+
     /// Nonzeros of the lower triangle of `A_c`.
     pub fn nonzeros(&self) -> usize {
         self.row_idx.len()

@@ -18,6 +18,7 @@ mod tet_evals;
 mod tet_tangent;
 mod workspace;
 
+pub(crate) use coarse_assembly::CoarseAssembly;
 pub use coarse_grid::CoarseGrid;
 pub use coarse_system::{CoarseError, CoarseSystem};
 pub use params::{CoarseRefresh, NewtonParams, Scheme, Smoother};

@@ -1,0 +1,106 @@
+//! A frame of the implicit scheme on the device: per implicit step the XPBD solver's
+//! prediction kernel, the Newton solve (`gpu/newton/`), then its contact, velocity and
+//! release-check kernels on the same simulation-time schedule. CPU twin:
+//! `Solver::run_implicit_steps` (crates/sim/src/xpbd/implicit_step.rs).
+
+use super::{GpuSolver, groups};
+use crate::gpu::GpuError;
+use crate::gpu::newton::OnDevice;
+use crate::xpbd::release_checks;
+
+impl GpuSolver {
+    /// Record and run the frame's implicit steps after the commands already in `enc`
+    /// (each Newton evaluation submits and reads back); returns the encoder holding the
+    /// frame's last commands, the stress pass included. Sets the host's pass count (the
+    /// frame's dispatches) and its conjugate-gradient cost.
+    pub(super) fn record_newton_frame(
+        &mut self,
+        enc: wgpu::CommandEncoder,
+    ) -> Result<wgpu::CommandEncoder, GpuError> {
+        let Some(mut newton) = self.newton.take() else {
+            return Ok(enc);
+        };
+        newton.dispatches = 0;
+        let done = self.newton_steps(&mut newton, enc);
+        self.host.passes += newton.dispatches;
+        self.newton = Some(newton);
+        done
+    }
+
+    /// The steps of [`GpuSolver::record_newton_frame`]; its own dispatches go to the host's
+    /// pass count, the Newton solver's to `newton.dispatches`.
+    fn newton_steps(
+        &mut self,
+        newton: &mut crate::gpu::newton::GpuNewton,
+        mut enc: wgpu::CommandEncoder,
+    ) -> Result<wgpu::CommandEncoder, GpuError> {
+        let p = &self.host.params;
+        let (h, n) = (p.step_length(), p.steps());
+        let checks = release_checks(self.host.time, h, n, p.release_interval);
+        let nodes = self.host.x.len();
+        let mut fresh = false;
+        let mut dispatches = 0;
+        self.host.implicit_cost = (0, 0);
+        for s in 0..n as usize {
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("newton step start"),
+                    timestamp_writes: None,
+                });
+                if s == 0 {
+                    // The frame's near-edge bit clears (as in the XPBD frame).
+                    pass.set_pipeline(&self.kernels.clear_frame);
+                    pass.set_bind_group(0, &self.bind.clear_frame, &[]);
+                    pass.dispatch_workgroups(groups(nodes), 1, 1);
+                    dispatches += 1;
+                }
+                pass.set_pipeline(&self.kernels.predict);
+                pass.set_bind_group(0, &self.bind.predict, &[]);
+                pass.set_bind_group(1, &self.bind.predict_steps[s], &[]);
+                pass.dispatch_workgroups(groups(nodes), 1, 1);
+                dispatches += 1;
+            }
+            let live: Vec<bool> = (self.host.slot_of_tet.iter())
+                .map(|&slot| self.host.slots[slot as usize].live)
+                .collect();
+            let dev = OnDevice {
+                device: &self.device,
+                queue: &self.queue,
+                pos: &self.buf.pos,
+                read_pos: &self.read.pos,
+            };
+            enc = newton.solve_step(&dev, &live, enc)?;
+            let r = newton.last;
+            self.host.implicit_cost.0 += r.cg_products;
+            self.host.implicit_cost.1 += u32::from(r.coarse_refreshed);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("newton step end"),
+                timestamp_writes: None,
+            });
+            if self.host.tool.is_some() {
+                pass.set_pipeline(&self.kernels.contact);
+                pass.set_bind_group(0, &self.bind.contact, &[]);
+                pass.set_bind_group(1, &self.bind.contact_steps[s], &[]);
+                pass.dispatch_workgroups(groups(nodes), 1, 1);
+                dispatches += 1;
+            }
+            pass.set_pipeline(&self.kernels.velocity);
+            pass.set_bind_group(0, &self.bind.velocity, &[]);
+            pass.dispatch_workgroups(groups(nodes), 1, 1);
+            dispatches += 1;
+            fresh = checks.contains(&(s as u32));
+            if fresh {
+                dispatches += self.record_release_check(&mut pass);
+            }
+        }
+        if !fresh {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("newton frame stress"),
+                timestamp_writes: None,
+            });
+            dispatches += self.record_stress(&mut pass);
+        }
+        self.host.passes = dispatches;
+        Ok(enc)
+    }
+}
