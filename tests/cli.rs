@@ -461,6 +461,30 @@ fn the_implicit_scheme_runs_on_either_device_and_checks_its_settings() {
         "{}",
         text(&o.stderr)
     );
+    // The Gauss–Seidel smoother exists on the CPU only: auto picks the CPU and says why,
+    // the GPU refuses it by name.
+    let smoothed = write(
+        "gauss_seidel.ron",
+        "scheme: Newton((smoother: GaussSeidel)),",
+    );
+    let o = run(smoothed.to_str().unwrap(), "auto", "gs_auto");
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let r: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("gs_auto/report.json")).unwrap()).unwrap();
+    assert!(r["device"].as_str().unwrap().starts_with("cpu"), "{r}");
+    assert!(
+        r["device_choice"].as_str().unwrap().contains("GaussSeidel"),
+        "{r}"
+    );
+    if incise_xr::RenderDevice::headless().is_ok() {
+        let o = run(smoothed.to_str().unwrap(), "gpu", "gs_gpu");
+        assert!(!o.status.success());
+        assert!(
+            text(&o.stderr).contains("smoother GaussSeidel runs on the CPU only"),
+            "{}",
+            text(&o.stderr)
+        );
+    }
 }
 
 /// `--device auto` says in report.json what it picked and why: on a software adapter

@@ -5,6 +5,7 @@ use anyhow::{Context, Result};
 use clap::ValueEnum;
 use incise_sim::Solver;
 use incise_sim::gpu::{GpuContext, GpuSolver};
+use incise_sim::implicit::{Scheme, Smoother};
 use incise_sim::xpbd::{FrameStats, SolverError};
 
 /// Where the solver runs.
@@ -54,6 +55,12 @@ pub fn auto_device(adapter: &wgpu::AdapterInfo) -> (DeviceChoice, String) {
     }
 }
 
+/// Whether the solver's settings exist on the CPU only (the implicit scheme's
+/// Gauss–Seidel smoother).
+fn cpu_only(solver: &Solver) -> bool {
+    matches!(solver.params().scheme, Scheme::Newton(p) if p.smoother == Smoother::GaussSeidel)
+}
+
 /// A solver on the CPU or the GPU.
 pub enum Body {
     /// CPU reference.
@@ -86,6 +93,12 @@ impl Body {
             DeviceChoice::Gpu => {
                 let ctx = context()?;
                 Ok(Body::Gpu(Box::new(GpuSolver::new(solver, &ctx)?)))
+            }
+            DeviceChoice::Auto if cpu_only(&solver) => {
+                notice(
+                    "--device auto: cpu, because the scene's solver.scheme smoother (GaussSeidel) runs on the CPU only",
+                );
+                Ok(Body::Cpu(Box::new(solver)))
             }
             DeviceChoice::Auto => match context() {
                 Ok(ctx) => {

@@ -40,6 +40,11 @@ pub enum GpuError {
     /// The implicit scheme's coarse level could not be built.
     #[error(transparent)]
     Coarse(#[from] crate::implicit::CoarseError),
+    /// The implicit scheme asks for a smoother the device does not have.
+    #[error(
+        "solver.scheme smoother {0} runs on the CPU only (the GPU smooths with block Jacobi): use --device cpu, or smoother: Jacobi"
+    )]
+    CpuOnlySmoother(&'static str),
     /// The implicit scheme's coarse level is too fine for its dense inverse on the device.
     #[error(
         "the implicit scheme's coarse level has {nodes} nodes; the GPU applies its inverse as a dense matrix and takes at most {max}: set a larger solver.scheme coarse_cell, or use --device cpu"

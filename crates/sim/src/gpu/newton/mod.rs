@@ -17,7 +17,7 @@ pub use kernels::{NEWTON_STAGES, newton_source};
 use wgpu::util::DeviceExt;
 
 use super::GpuError;
-use crate::implicit::{NewtonParams, NewtonReport, Scheme};
+use crate::implicit::{NewtonParams, NewtonReport, Scheme, Smoother};
 use crate::xpbd::{NodeKind, Solver};
 use coarse::HostCoarse;
 use kernels::NewtonKernels;
@@ -135,6 +135,9 @@ impl GpuNewton {
         let Scheme::Newton(params) = host.params.scheme else {
             return Ok(None);
         };
+        if params.smoother == Smoother::GaussSeidel {
+            return Err(GpuError::CpuOnlySmoother("GaussSeidel"));
+        }
         let mesh = &host.mesh;
         let (n, slots) = (host.x.len(), host.slots.len());
         let h = host.params.step_length();
