@@ -81,6 +81,9 @@ struct TwoLevel {
     assembly: Option<CoarseAssembly>,
     /// The tangents of the last refresh, per tet (what a release subtracts).
     used: Vec<TetTangent>,
+    /// Per tet, whether the coarse matrix holds its blocks at `used` (live at the last
+    /// refresh and not released since).
+    in_coarse: Vec<bool>,
     /// Steps since the last refresh.
     since_refresh: u32,
     /// The assembled Hessian for the Gauss–Seidel smoother (`None`: block Jacobi).
@@ -147,6 +150,7 @@ impl NewtonWorkspace {
                 coarse,
                 assembly,
                 used: Vec::new(),
+                in_coarse: Vec::new(),
                 since_refresh: 0,
                 matrix,
             },
@@ -168,7 +172,14 @@ impl NewtonWorkspace {
     pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
         let pre = &mut self.pre;
         if let (Some(assembly), false) = (&pre.assembly, pre.used.is_empty()) {
-            return pre.coarse.release_refreshed(assembly, tets, &pre.used);
+            // A tet released by a check earlier in the frame may have been left out of a
+            // refresh since: it is subtracted only if the matrix holds it.
+            let held: Vec<u32> = tets
+                .iter()
+                .copied()
+                .filter(|&t| std::mem::take(&mut pre.in_coarse[t as usize]))
+                .collect();
+            return pre.coarse.release_refreshed(assembly, &held, &pre.used);
         }
         let gone: Vec<RestTet> = tets
             .iter()
@@ -192,20 +203,8 @@ impl NewtonWorkspace {
         let mut report = NewtonReport::default();
         let mut g_now = self.hessian.evaluate(u, y, live, free, parallel);
         if self.refresh_due() {
-            let evals = &self.hessian.evals;
-            let pre = &mut self.pre;
-            // The blocks are these tangents' even where the factor stayed the old one.
-            pre.used.clear();
-            pre.used.extend((0..live.len()).map(|t| evals.tangent(t)));
-            let used = &pre.used;
-            let tangent = |t: usize| live[t].then(|| &used[t]);
-            let assembly = pre
-                .assembly
-                .as_mut()
-                .expect("a refresh policy has an assembly");
             report.coarse_refreshed = true;
-            report.coarse_refresh_failed = pre.coarse.refresh(assembly, tangent, parallel).is_err();
-            pre.since_refresh = 0;
+            report.coarse_refresh_failed = self.refresh_coarse(live, parallel).is_err();
         }
         self.pre.since_refresh += 1;
         if let Some(m) = &mut self.pre.matrix {
@@ -270,6 +269,26 @@ impl NewtonWorkspace {
             }
         }
         self.last = report;
+    }
+
+    /// Re-assemble the coarse matrix from the live tets' current tangents and refactorise
+    /// it (the previous factor stays where the new one fails).
+    fn refresh_coarse(&mut self, live: &[bool], parallel: bool) -> Result<(), CoarseError> {
+        let evals = &self.hessian.evals;
+        let pre = &mut self.pre;
+        // The blocks are these tangents' even where the factor stayed the old one.
+        pre.used.clear();
+        pre.used.extend((0..live.len()).map(|t| evals.tangent(t)));
+        pre.in_coarse.clear();
+        pre.in_coarse.extend_from_slice(live);
+        pre.since_refresh = 0;
+        let used = &pre.used;
+        let tangent = |t: usize| live[t].then(|| &used[t]);
+        let assembly = pre
+            .assembly
+            .as_mut()
+            .expect("a refresh policy has an assembly");
+        pre.coarse.refresh(assembly, tangent, parallel)
     }
 
     /// Whether this step re-assembles the coarse matrix (module docs, [`CoarseRefresh`]).
@@ -740,6 +759,42 @@ mod tests {
             .map(|(p, q)| (*p - *q).length())
             .fold(0.0, f32::max);
         (err, scale)
+    }
+
+    /// A tet released by a check earlier in the frame and left out of a refresh since is
+    /// not subtracted from the coarse matrix a second time when the frame hands its
+    /// releases over: the matrix is then the refresh of the live tets.
+    #[test]
+    fn a_release_after_a_refresh_without_the_tet_subtracts_nothing() {
+        let (mesh, mut fresh, free) = setup();
+        let (_, mut released, _) = setup();
+        let n = mesh.node_count();
+        let u = wobble(n, 1e-5);
+        let mut live = vec![true; mesh.tet_count()];
+        live[5] = false;
+        let rhs: Vec<f64> = (0..fresh.pre.rhs.len())
+            .map(|i| (i as f64 * 0.37).sin())
+            .collect();
+        let mut solved = Vec::new();
+        for ws in [&mut fresh, &mut released] {
+            ws.hessian.evaluate(&u, &u, &live, &free, false);
+            ws.refresh_coarse(&live, false).unwrap();
+        }
+        released.release(&[5]).unwrap();
+        for ws in [&fresh, &released] {
+            let mut x = rhs.clone();
+            ws.pre.coarse.solve(&mut x);
+            solved.push(x);
+        }
+        let scale = solved[0].iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        let err = solved[0]
+            .iter()
+            .zip(&solved[1])
+            .fold(0.0f64, |a, (p, q)| a.max((p - q).abs()));
+        assert!(
+            scale > 0.0 && err <= 1e-9 * scale,
+            "the released tet was subtracted again: off by {err} of {scale}"
+        );
     }
 
     /// `∇²G p` against central differences of `∇G`, and positive curvature near rest.
