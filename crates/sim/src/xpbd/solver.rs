@@ -123,10 +123,9 @@ impl Solver {
         let lame = material.lame();
         let (colors, ncolors) = greedy_tet_colors(mesh.node_count(), &mesh.tets);
         // Colour first (the coloured sweep and the GPU), then the sweep plan's group, then
-        // along the locality curve (`xpbd/locality.rs`): inside a colour the order changes
-        // no result.
+        // by lowest node (`xpbd/locality.rs`): inside a colour the order changes no result.
         let groups = tet_groups(&mesh.rest_positions, &mesh.tets);
-        let near = tet_order.keys(&mesh.rest_positions, &mesh.tets);
+        let near = tet_order.keys(&mesh.tets);
         let mut order: Vec<u32> = (0..mesh.tet_count() as u32).collect();
         order.sort_by_key(|&t| (colors[t as usize], groups[t as usize], near[t as usize], t));
         let keys: Vec<(u32, u32)> = order
@@ -224,13 +223,17 @@ impl Solver {
                 live: true,
             })
             .collect();
-        solver.packed = RunProjector::lane_kernel(&solver.params).map(|_| {
-            let spans: Vec<_> = match solver.params.cpu_sweep {
-                CpuSweep::Coloured => solver.color_ranges.clone(),
-                CpuSweep::Blocks => solver.plan.runs.iter().flatten().cloned().collect(),
-            };
-            LaneSlots::new(&solver.slots, spans)
-        });
+        // Only the XPBD sweep projects the packed blocks.
+        let sweeps = solver.params.scheme == Scheme::Xpbd;
+        solver.packed = RunProjector::lane_kernel(&solver.params)
+            .filter(|_| sweeps)
+            .map(|_| {
+                let spans: Vec<_> = match solver.params.cpu_sweep {
+                    CpuSweep::Coloured => solver.color_ranges.clone(),
+                    CpuSweep::Blocks => solver.plan.runs.iter().flatten().cloned().collect(),
+                };
+                LaneSlots::new(&solver.slots, spans)
+            });
         Ok(solver)
     }
 
@@ -367,7 +370,8 @@ impl Solver {
     }
 
     /// Mesh tet of each slot: the order the solver and the GPU keep per-tet data in
-    /// (colour, then the partitioned sweep's group, then mesh index).
+    /// (colour, then the partitioned sweep's group, then lowest node unless built in
+    /// [`TetOrder::Mesh`], then mesh index: `xpbd/locality.rs`).
     pub fn slot_tets(&self) -> &[u32] {
         &self.tet_of_slot
     }

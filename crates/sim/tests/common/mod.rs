@@ -129,14 +129,23 @@ pub fn tearing_bar(threads: usize) -> Solver {
 /// [`tearing_bar`] with its settings (release at 6 kPa, the rest default) changed by
 /// `adjust`.
 pub fn tearing_bar_with(adjust: impl FnOnce(&mut SolverParams)) -> Solver {
-    tearing_bar_in(TetOrder::default(), adjust)
+    tearing_bar_on(tearing_bar_mesh(), TetOrder::default(), adjust)
 }
 
-/// [`tearing_bar_with`] with the solver's tets stored in `order` inside each colour.
-pub fn tearing_bar_in(order: TetOrder, adjust: impl FnOnce(&mut SolverParams)) -> Solver {
+/// The tearing bar's mesh: 20 × 6 × 6 hexes of 5 mm, six tets each.
+pub fn tearing_bar_mesh() -> TetMesh {
+    block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6))
+}
+
+/// [`tearing_bar_with`] on `mesh` (the bar's, its tets listed in any order), the solver's
+/// tets stored in `order` inside each colour.
+pub fn tearing_bar_on(
+    mesh: TetMesh,
+    order: TetOrder,
+    adjust: impl FnOnce(&mut SolverParams),
+) -> Solver {
     use incise_sim::grab::Grab;
     use incise_sim::selection::NodeSelection;
-    let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6));
     let mut params = SolverParams {
         release_threshold: Some(6e3),
         ..SolverParams::default()
