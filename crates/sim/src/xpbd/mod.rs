@@ -8,13 +8,16 @@ mod lane;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod lane_avx;
 mod lane_pass;
+mod lane_slots;
 pub(crate) mod lanes;
+mod locality;
 mod neo_hookean;
 mod params;
 mod release_schedule;
 mod rest_free;
 pub(crate) mod rest_free_lanes;
 mod retune;
+mod run_projector;
 mod shared_nodes;
 mod solver;
 mod stability;
@@ -26,6 +29,7 @@ mod tet_slot;
 pub use coloring::greedy_tet_colors;
 pub use flop_count::{LN_FLOPS, NODE_FLOPS_PER_SUBSTEP, projection_flops};
 pub use frame::FrameStats;
+pub use locality::TetOrder;
 pub use neo_hookean::{
     ConstraintPair, TetProjection, TetTerms, deformation_gradient, det_gradient,
 };

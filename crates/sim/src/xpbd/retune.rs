@@ -13,7 +13,7 @@ impl Solver {
     /// continues the motion. Refused (unusable material, unstable substeps) as
     /// [`Solver::new`] refuses; `self` is unchanged either way.
     pub fn retuned(&self, material: Material, params: SolverParams) -> Result<Solver, SolverError> {
-        let mut s = Solver::new(self.mesh.clone(), material, params)?;
+        let mut s = Solver::with_tet_order(self.mesh.clone(), material, params, self.tet_order)?;
         s.u.clone_from(&self.u);
         s.u_prev.clone_from(&self.u_prev);
         s.x.clone_from(&self.x);

@@ -8,17 +8,16 @@ use glam::{Mat3, Quat, Vec3};
 use rayon::prelude::*;
 
 use super::coloring::greedy_tet_colors;
-use super::lane_pass;
-use super::neo_hookean::{
-    ConstraintPair, TetProjection, TetTerms, deformation_gradient_from_displacement,
-};
+use super::lane_slots::LaneSlots;
+use super::locality::TetOrder;
+use super::neo_hookean::{ConstraintPair, TetTerms, deformation_gradient_from_displacement};
 use super::release_schedule::release_checks;
+use super::run_projector::{CHUNK, RunProjector, SharedLambdas};
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
 use super::sweep_plan::{SweepPlan, tet_groups};
-use super::tet_constraint::project_tet;
 use super::tet_slot::TetSlot;
-use super::{CpuKernel, CpuSweep, FrameStats, SolverError, SolverParams};
+use super::{CpuSweep, FrameStats, SolverError, SolverParams};
 use crate::contact::{ContactTool, CutZone, ToolMotion, ToolPose, project_node};
 use crate::cutting::{CutState, ReleaseEvent};
 use crate::grab::Grab;
@@ -27,9 +26,6 @@ use crate::material::{Lame, Material};
 use crate::mesh::TetMesh;
 use crate::stress::{StressMeasure, cauchy_stress, tet_stress, von_mises};
 use crate::xpbd::{Strain, displacement_gradient};
-
-/// Tets per rayon task: large enough to amortise scheduling, small enough to balance.
-const CHUNK: usize = 256;
 
 /// How a node moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,6 +59,10 @@ pub struct Solver {
     pub(crate) start: Vec<Vec3>,
     pub(crate) grabs: Vec<Grab>,
     pub(crate) slots: Vec<TetSlot>,
+    /// The slots packed for the SIMD lanes, span by span of the sweep (lane kernels only).
+    pub(crate) packed: Option<LaneSlots>,
+    /// The order of the tets inside each colour and group.
+    pub(crate) tet_order: TetOrder,
     pub(crate) color_ranges: Vec<std::ops::Range<usize>>,
     /// The slots of each slab and cut per colour, for the partitioned sweep.
     pub(crate) plan: SweepPlan,
@@ -106,15 +106,28 @@ impl Solver {
         material: Material,
         params: SolverParams,
     ) -> Result<Self, SolverError> {
+        Self::with_tet_order(mesh, material, params, TetOrder::default())
+    }
+
+    /// [`Solver::new`] with the tets of each colour stored in `order` (the same results
+    /// in any order: tests and measurement).
+    pub fn with_tet_order(
+        mesh: TetMesh,
+        material: Material,
+        params: SolverParams,
+        tet_order: TetOrder,
+    ) -> Result<Self, SolverError> {
         material.validate()?;
         params.validate()?;
         params.check_material(&material)?;
         let lame = material.lame();
         let (colors, ncolors) = greedy_tet_colors(mesh.node_count(), &mesh.tets);
-        // Colour first (the coloured sweep and the GPU), then the sweep plan's group.
+        // Colour first (the coloured sweep and the GPU), then the sweep plan's group, then
+        // by lowest node (`xpbd/locality.rs`): inside a colour the order changes no result.
         let groups = tet_groups(&mesh.rest_positions, &mesh.tets);
+        let near = tet_order.keys(&mesh.tets);
         let mut order: Vec<u32> = (0..mesh.tet_count() as u32).collect();
-        order.sort_by_key(|&t| (colors[t as usize], groups[t as usize], t));
+        order.sort_by_key(|&t| (colors[t as usize], groups[t as usize], near[t as usize], t));
         let keys: Vec<(u32, u32)> = order
             .iter()
             .map(|&t| (colors[t as usize], groups[t as usize]))
@@ -168,6 +181,8 @@ impl Solver {
             kind: vec![NodeKind::Free; n],
             grabs: Vec::new(),
             slots: Vec::new(),
+            packed: None,
+            tet_order,
             color_ranges,
             plan,
             slot_of_tet,
@@ -208,7 +223,27 @@ impl Solver {
                 live: true,
             })
             .collect();
+        // Only the XPBD sweep projects the packed blocks.
+        let sweeps = solver.params.scheme == Scheme::Xpbd;
+        solver.packed = RunProjector::lane_kernel(&solver.params)
+            .filter(|_| sweeps)
+            .map(|_| {
+                let spans: Vec<_> = match solver.params.cpu_sweep {
+                    CpuSweep::Coloured => solver.color_ranges.clone(),
+                    CpuSweep::Blocks => solver.plan.runs.iter().flatten().cloned().collect(),
+                };
+                LaneSlots::new(&solver.slots, spans)
+            });
         Ok(solver)
+    }
+
+    /// Switch mesh tet `t` on or off in the sweep (its slot and packed lane).
+    fn set_live(&mut self, t: u32, live: bool) {
+        let s = self.slot_of_tet[t as usize] as usize;
+        self.slots[s].live = live;
+        if let Some(p) = &mut self.packed {
+            p.set_live(s, live);
+        }
     }
 
     /// Compliance terms of tet `t` for the current substep length.
@@ -335,7 +370,8 @@ impl Solver {
     }
 
     /// Mesh tet of each slot: the order the solver and the GPU keep per-tet data in
-    /// (colour, then the partitioned sweep's group, then mesh index).
+    /// (colour, then the partitioned sweep's group, then lowest node unless built in
+    /// [`TetOrder::Mesh`], then mesh index: `xpbd/locality.rs`).
     pub fn slot_tets(&self) -> &[u32] {
         &self.tet_of_slot
     }
@@ -424,7 +460,7 @@ impl Solver {
     pub fn release(&mut self, tets: &[u32]) -> ReleaseEvent {
         let ev = self.cut.release(&self.mesh, tets);
         for &t in &ev.tets {
-            self.slots[self.slot_of_tet[t as usize] as usize].live = false;
+            self.set_live(t, false);
         }
         if let Some(ws) = &mut self.newton {
             // The coarse level only preconditions: a failed refresh keeps the old one.
@@ -501,7 +537,7 @@ impl Solver {
     /// Switch the tets of a rolled-back frame's release checks back on.
     fn revive_pending(&mut self) {
         for t in std::mem::take(&mut self.pending) {
-            self.slots[self.slot_of_tet[t as usize] as usize].live = true;
+            self.set_live(t, true);
         }
     }
 
@@ -611,38 +647,30 @@ impl Solver {
     /// Project every live tet of colour `c` (no two share a node).
     fn project_color(&mut self, c: usize, parallel: bool) {
         let range = self.color_ranges[c].clone();
-        let projector = RunProjector::of(&self.params, &self.inv_mass);
+        let packed = self.packed.as_ref();
+        let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
         let nodes = SharedNodes::new(&mut self.u);
-        let slots = &self.slots[range.clone()];
-        let lambdas = &mut self.lambda_h[range];
-        // SAFETY: tets of one colour share no node, and each run is one task's.
-        let run = |(s, l): (&[TetSlot], &mut [f32])| unsafe { projector.run(s, l, &nodes) };
-        if parallel && slots.len() > CHUNK {
-            slots
-                .par_chunks(CHUNK)
-                .zip(lambdas.par_chunks_mut(CHUNK))
-                .for_each(run);
-        } else {
-            run((slots, lambdas));
-        }
+        let lambdas = SharedLambdas::new(&mut self.lambda_h);
+        // SAFETY: tets of one colour share no node; this pass is the only one. The packed
+        // spans of the coloured sweep are its colours.
+        unsafe { projector.span(c, range, &lambdas, &nodes, parallel) };
     }
 
     /// One sweep in the partitioned order (`xpbd/sweep_plan.rs`): phase after phase, the
     /// phase's groups in parallel, each group's tets colour after colour.
     fn project_blocks(&mut self, parallel: bool) {
-        let projector = RunProjector::of(&self.params, &self.inv_mass);
+        let packed = self.packed.as_ref();
+        let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
         let nodes = SharedNodes::new(&mut self.u);
-        let lambdas = SharedLambdas(self.lambda_h.as_mut_ptr());
-        let (slots, plan) = (&self.slots, &self.plan);
+        let lambdas = SharedLambdas::new(&mut self.lambda_h);
+        let (plan, colours) = (&self.plan, self.color_ranges.len());
         let group = |g: &usize| {
-            for r in &plan.runs[*g] {
+            for (c, r) in plan.runs[*g].iter().enumerate() {
                 // SAFETY: the groups of one phase share no node (slabs and alternate
                 // cuts), each run's tets are of one colour, and runs are disjoint ranges
-                // of the multipliers.
-                unsafe {
-                    let l = std::slice::from_raw_parts_mut(lambdas.at(r.start), r.len());
-                    projector.run(&slots[r.clone()], l, &nodes);
-                }
+                // of the slots. The packed spans of the partitioned sweep are its runs,
+                // group by group.
+                unsafe { projector.span(*g * colours + c, r.clone(), &lambdas, &nodes, false) };
             }
         };
         for phase in &plan.phases {
@@ -786,7 +814,7 @@ impl Solver {
             .map(|t| t as u32)
             .collect();
         for &t in &over {
-            self.slots[self.slot_of_tet[t as usize] as usize].live = false;
+            self.set_live(t, false);
         }
         self.pending.extend(over);
         self.near_window.iter_mut().for_each(|b| *b = false);
@@ -851,70 +879,6 @@ impl Solver {
             passes: self.passes,
             cg_products: self.implicit_cost.0,
             coarse_refreshes: self.implicit_cost.1,
-        }
-    }
-}
-
-/// The volume multipliers written by the tasks of the partitioned sweep.
-struct SharedLambdas(*mut f32);
-
-// SAFETY: each task writes only its own runs' disjoint ranges (`Solver::project_blocks`).
-unsafe impl Sync for SharedLambdas {}
-
-impl SharedLambdas {
-    /// The multiplier of slot `s`.
-    fn at(&self, s: usize) -> *mut f32 {
-        // SAFETY: `s` is a slot index, inside the array (the caller's runs).
-        unsafe { self.0.add(s) }
-    }
-}
-
-/// Projects runs of one colour's tets with the solver's kernel and constraint pair.
-struct RunProjector<'a> {
-    inv_mass: &'a [f32],
-    lanes: Option<bool>,
-    mode: TetProjection,
-    pair: ConstraintPair,
-}
-
-impl<'a> RunProjector<'a> {
-    /// The projector of `params`' kernel and pair: eight tets at a time in SIMD lanes (with
-    /// run-time AVX2 detection or not), or one by one.
-    fn of(params: &SolverParams, inv_mass: &'a [f32]) -> Self {
-        let (mode, pair) = (params.projection, params.constraints);
-        let lanes = match params.cpu_kernel {
-            CpuKernel::Lanes => Some(true),
-            CpuKernel::PortableLanes => Some(false),
-            CpuKernel::Scalar => None,
-        }
-        .filter(|_| pair == ConstraintPair::RestFree && mode == TetProjection::Coupled);
-        RunProjector {
-            inv_mass,
-            lanes,
-            mode,
-            pair,
-        }
-    }
-
-    /// Project `slots` (one colour's, sharing no node) and store their volume multipliers.
-    ///
-    /// # Safety
-    /// No other thread may touch these tets' nodes during the call.
-    unsafe fn run(&self, slots: &[TetSlot], lambdas: &mut [f32], nodes: &SharedNodes) {
-        if let Some(detect) = self.lanes {
-            // SAFETY: the caller's contract.
-            return unsafe { lane_pass::project_run(slots, lambdas, nodes, self.inv_mass, detect) };
-        }
-        for (slot, lambda) in slots.iter().zip(lambdas).filter(|(s, _)| s.live) {
-            let idx = slot.nodes;
-            // SAFETY: the caller's contract.
-            let mut p = idx.map(|i| unsafe { nodes.get(i) });
-            let w = idx.map(|i| self.inv_mass[i as usize]);
-            *lambda = project_tet(&mut p, &w, &slot.terms, self.mode, self.pair);
-            for k in 0..4 {
-                // SAFETY: as above.
-                unsafe { nodes.set(idx[k], p[k]) };
-            }
         }
     }
 }

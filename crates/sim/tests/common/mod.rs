@@ -6,7 +6,7 @@ pub mod stretched_bar;
 
 use glam::{UVec3, Vec3};
 use incise_sim::generate::block;
-use incise_sim::xpbd::{stiffness_number, substeps_needed};
+use incise_sim::xpbd::{TetOrder, stiffness_number, substeps_needed};
 use incise_sim::{Material, Solver, SolverParams, TetMesh};
 
 /// A validated block mesh from `min` with edge lengths `size`, `cells` hexes.
@@ -129,15 +129,31 @@ pub fn tearing_bar(threads: usize) -> Solver {
 /// [`tearing_bar`] with its settings (release at 6 kPa, the rest default) changed by
 /// `adjust`.
 pub fn tearing_bar_with(adjust: impl FnOnce(&mut SolverParams)) -> Solver {
+    tearing_bar_on(tearing_bar_mesh(), TetOrder::default(), adjust)
+}
+
+/// The tearing bar's mesh: 20 × 6 × 6 hexes of 5 mm, six tets each.
+pub fn tearing_bar_mesh() -> TetMesh {
+    block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6))
+}
+
+/// [`tearing_bar_with`] on `mesh` (the bar's, its tets listed in any order), the solver's
+/// tets stored in `order` inside each colour.
+pub fn tearing_bar_on(
+    mesh: TetMesh,
+    order: TetOrder,
+    adjust: impl FnOnce(&mut SolverParams),
+) -> Solver {
     use incise_sim::grab::Grab;
     use incise_sim::selection::NodeSelection;
-    let mesh = block_mesh(Vec3::ZERO, Vec3::new(0.1, 0.03, 0.03), UVec3::new(20, 6, 6));
     let mut params = SolverParams {
         release_threshold: Some(6e3),
         ..SolverParams::default()
     };
     adjust(&mut params);
-    let mut s = solver(mesh, soft(30e3, 0.4), params);
+    let m = soft(30e3, 0.4);
+    params.substeps = stable_substeps(&mesh, &m, &params);
+    let mut s = Solver::with_tet_order(mesh, m, params, order).expect("valid solver settings");
     let rest = s.mesh().rest_positions.clone();
     let left = NodeSelection::PlaneSide {
         point: Vec3::new(0.002, 0.0, 0.0),
