@@ -79,23 +79,28 @@ fn tet_blocks_in<L: Lane>(
         let ca = a[j] * c;
         let d = b[j].dot(b[k]) * mu;
         let g = f.mul_vec(b[j].cross(b[k])) * s3;
-        let y = a[k];
-        let e = [
-            d + ca.x * y.x,
-            ca.x * y.y + g.z,
-            ca.x * y.z - g.y,
-            ca.y * y.x - g.z,
-            d + ca.y * y.y,
-            ca.y * y.z + g.x,
-            ca.z * y.x + g.y,
-            ca.z * y.y - g.x,
-            d + ca.z * y.z,
-        ];
-        for (o, e) in o.iter_mut().zip(e) {
+        for (o, e) in o.iter_mut().zip(pair_entries(d, ca, a[k], g)) {
             *o = e.to_array();
         }
     }
     out
+}
+
+/// The entries, row-major, of `d I + ca yᵀ − [g]ₓ`: `pair_block` with `d = μ (β_j·β_k)`,
+/// `ca = c a_j`, `y = a_k` and `g = s₃ F (β_j × β_k)` (coarse_assembly.rs).
+#[inline(always)]
+pub(super) fn pair_entries<L: Lane>(d: L, ca: V3<L>, y: V3<L>, g: V3<L>) -> [L; 9] {
+    [
+        d + ca.x * y.x,
+        ca.x * y.y + g.z,
+        ca.x * y.z - g.y,
+        ca.y * y.x - g.z,
+        d + ca.y * y.y,
+        ca.y * y.z + g.x,
+        ca.z * y.x + g.y,
+        ca.z * y.y - g.x,
+        d + ca.z * y.z,
+    ]
 }
 
 /// `σ̂ ≥ σ_max(F)`, at least 1 (block_matrix.rs `largest_stretch_bound`).

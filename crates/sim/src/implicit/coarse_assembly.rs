@@ -24,6 +24,7 @@ use std::ops::Range;
 use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
+use super::block_lanes::pair_entries;
 use super::coarse_grid::CoarseGrid;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
@@ -330,20 +331,8 @@ fn chunk_pairs<L: Lane>(
         for k in j..m {
             let d = b[j].dot(b[k]) * mu;
             let g = f.mul_vec(b[j].cross(b[k])) * s3;
-            let y = a[k];
-            let e = [
-                d + ca.x * y.x,
-                ca.x * y.y + g.z,
-                ca.x * y.z - g.y,
-                ca.y * y.x - g.z,
-                d + ca.y * y.y,
-                ca.y * y.z + g.x,
-                ca.z * y.x + g.y,
-                ca.z * y.y - g.x,
-                d + ca.z * y.z,
-            ];
             let sum = pairs.next().expect("a sum per pair");
-            for (s, e) in sum.iter_mut().zip(e) {
+            for (s, e) in sum.iter_mut().zip(pair_entries(d, ca, a[k], g)) {
                 *s = (L::new(*s) + e).to_array();
             }
         }

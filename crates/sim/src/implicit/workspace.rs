@@ -544,19 +544,9 @@ mod tests {
         (mesh, ws, free)
     }
 
-    fn wobble(n: usize, scale: f32) -> Vec<Vec3> {
-        (0..n)
-            .map(|i| {
-                let f = i as f32;
-                Vec3::new((f * 0.7).sin(), (f * 1.3).cos(), (f * 0.4).sin()) * scale
-            })
-            .collect()
-    }
-
-    /// The SIMD product equals the tet-by-tet one to rounding, on a mesh whose tet count
-    /// is not a multiple of eight and with some tets released.
-    #[test]
-    fn the_lanes_product_is_the_scalar_product() {
+    /// A 3.5 × 1.5 × 1 cm block pinned at x = 0 whose tet count is not a multiple of
+    /// eight, with the scalar kernels and with the lanes.
+    fn odd_blocks() -> (TetMesh, [NewtonWorkspace; 2], Vec<bool>) {
         let raw = block(
             Vec3::ZERO,
             Vec3::new(0.035, 0.015, 0.01),
@@ -581,7 +571,24 @@ mod tests {
             )
             .unwrap()
         };
-        let (mut scalar, mut lanes) = (make(false), make(true));
+        let pair = [make(false), make(true)];
+        (mesh, pair, free)
+    }
+
+    fn wobble(n: usize, scale: f32) -> Vec<Vec3> {
+        (0..n)
+            .map(|i| {
+                let f = i as f32;
+                Vec3::new((f * 0.7).sin(), (f * 1.3).cos(), (f * 0.4).sin()) * scale
+            })
+            .collect()
+    }
+
+    /// The SIMD product equals the tet-by-tet one to rounding, on a mesh whose tet count
+    /// is not a multiple of eight and with some tets released.
+    #[test]
+    fn the_lanes_product_is_the_scalar_product() {
+        let (mesh, [mut scalar, mut lanes], free) = odd_blocks();
         let n = mesh.node_count();
         let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 5 != 3).collect();
         let u = wobble(n, 1e-3);
@@ -609,31 +616,7 @@ mod tests {
     /// is the evaluation's to the bit.
     #[test]
     fn the_lanes_evaluation_is_the_scalar_evaluation() {
-        let raw = block(
-            Vec3::ZERO,
-            Vec3::new(0.035, 0.015, 0.01),
-            glam::UVec3::new(7, 3, 2),
-        );
-        let mesh = TetMesh::from_raw(raw).unwrap().0;
-        assert_ne!(mesh.tet_count() % LANES, 0);
-        let free: Vec<bool> = mesh.rest_positions.iter().map(|p| p.x > 1e-4).collect();
-        let lame = Lame {
-            mu: 6.2e4,
-            lambda: 5.59e5,
-        };
-        let mass = mesh.lumped_masses(1040.0);
-        let make = |lanes| {
-            NewtonWorkspace::new(
-                &mesh,
-                &mass,
-                &free,
-                lame,
-                (1.0 / 60.0, lanes),
-                NewtonParams::default(),
-            )
-            .unwrap()
-        };
-        let (mut scalar, mut lanes) = (make(false), make(true));
+        let (mesh, [mut scalar, mut lanes], free) = odd_blocks();
         let n = mesh.node_count();
         let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 5 != 3).collect();
         // Up to 4 mm on 5 mm cells: some tets flattened past J_MIN or inverted.
