@@ -99,13 +99,30 @@ pub struct SoakReport {
     pub problems: Vec<String>,
 }
 
-/// Resident set size of this process, KiB (Linux `/proc/self/statm`; 0 elsewhere).
+/// Resident set size of this process, KiB (Linux `/proc/self/statm`; 0 elsewhere), after
+/// the allocator has handed its free pages back (glibc `malloc_trim`): what stays is what
+/// the process holds, not where a large block freed by the last cut happened to sit.
 pub fn rss_kib() -> u64 {
+    trim_allocator();
     let page_kib = 4;
     std::fs::read_to_string("/proc/self/statm")
         .ok()
         .and_then(|s| s.split_whitespace().nth(1)?.parse::<u64>().ok())
         .map_or(0, |pages| pages * page_kib)
+}
+
+/// Return the allocator's free pages to the system (glibc; nothing elsewhere).
+fn trim_allocator() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        unsafe extern "C" {
+            fn malloc_trim(pad: usize) -> i32;
+        }
+        // SAFETY: glibc's malloc_trim takes no pointers and may be called at any time.
+        unsafe {
+            malloc_trim(0);
+        }
+    }
 }
 
 /// Open file descriptors of this process (Linux `/proc/self/fd`; 0 elsewhere).
@@ -438,6 +455,31 @@ mod tests {
             !judge(&cycles(&[120_000, 110_000, 120_000]))
                 .problems
                 .is_empty()
+        );
+    }
+
+    /// The resident size counts memory the process holds (a leaked, touched 16 MiB), not
+    /// memory it freed (16 MiB in small blocks, freed but for the last one, which keeps the
+    /// heap's top in use).
+    #[test]
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    fn the_resident_size_counts_held_memory_not_freed() {
+        let before = rss_kib();
+        let mut blocks: Vec<Vec<u8>> = (0..128 * 1024).map(|i| vec![i as u8; 128]).collect();
+        let last = blocks.pop();
+        drop(blocks);
+        let freed = rss_kib();
+        assert!(
+            freed < before + 4 * 1024,
+            "16 MiB freed still counted: {before} → {freed} KiB"
+        );
+        drop(last);
+        let leaked: &mut [u8] =
+            std::hint::black_box(Box::leak(vec![1u8; 16 << 20].into_boxed_slice()));
+        let held = rss_kib();
+        assert!(
+            held >= before + 15 * 1024 && leaked.iter().all(|&b| b == 1),
+            "16 MiB leaked not counted: {before} → {held} KiB"
         );
     }
 }
