@@ -7,24 +7,23 @@
 //!
 //! over the free nodes (pinned and grabbed nodes hold their targets). Each Newton
 //! iteration solves `∇²G d = −∇G` by [`pcg`] with the exact Hessian applied tet by tet
-//! ([`TetTangent`]) and a two-level preconditioner: block Jacobi (each node's 3×3
+//! ([`super::TetTangent`]) and a two-level preconditioner: block Jacobi (each node's 3×3
 //! diagonal block, as VBD's local system) or, with `smoother: GaussSeidel`, a symmetric
 //! block Gauss–Seidel sweep on the Hessian assembled at the step's first iterate
-//! ([`BlockMatrix`]), plus a coarse-grid correction `P A_c⁻¹ Pᵀ` ([`CoarseSystem`]). A
+//! ([`BlockMatrix`]), plus a coarse-grid correction `P A_c⁻¹ Pᵀ` ([`super::CoarseLevel`]). A
 //! backtracking line search on `G` keeps every step a descent.
 
 use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
 use super::block_matrix::BlockMatrix;
-use super::coarse_assembly::CoarseAssembly;
-use super::coarse_grid::CoarseGrid;
-use super::coarse_system::{CoarseError, CoarseSystem};
-use super::params::{CoarseRefresh, NewtonParams, Smoother};
+use super::coarse_level::CoarseLevel;
+use super::coarse_system::CoarseError;
+use super::newton_report::NewtonReport;
+use super::params::{NewtonParams, Smoother};
 use super::pcg::{dot, pcg};
 use super::rest_tet::RestTet;
 use super::tet_evals::{Iterate, TetEvals, for_each};
-use super::tet_tangent::TetTangent;
 use crate::material::Lame;
 use crate::mesh::TetMesh;
 use crate::vbd::shape_gradients;
@@ -35,26 +34,6 @@ const CHUNK: usize = 256;
 const ARMIJO: f64 = 1e-4;
 /// Most halvings of a Newton step before the step is abandoned.
 const MAX_HALVINGS: u32 = 8;
-
-/// What the last implicit step cost.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct NewtonReport {
-    /// Newton iterations taken.
-    pub iterations: u32,
-    /// Hessian–vector products over all iterations.
-    pub cg_products: u32,
-    /// Iterations whose conjugate gradient met non-positive curvature.
-    pub negative_curvature: u32,
-    /// Step halvings of the line search.
-    pub halvings: u32,
-    /// `|∇G|` where the last iteration started (or where the gradient stop ended the step)
-    /// over `|∇G|` at the step's first iterate (free nodes, 2-norm).
-    pub gradient_ratio: f32,
-    /// Whether the coarse matrix was re-assembled from the current tangents this step.
-    pub coarse_refreshed: bool,
-    /// Whether that refresh was not positive definite (the previous factor was kept).
-    pub coarse_refresh_failed: bool,
-}
 
 /// The Hessian of `G` applied matrix-free.
 struct Hessian {
@@ -74,18 +53,7 @@ struct Hessian {
 /// Block Jacobi plus the coarse correction.
 struct TwoLevel {
     diag_inv: Vec<Mat3>,
-    grid: CoarseGrid,
-    coarse: CoarseSystem,
-    /// The tets' corner pairs for re-assembling `coarse` (`None` under
-    /// [`CoarseRefresh::Rest`]).
-    assembly: Option<CoarseAssembly>,
-    /// The tangents of the last refresh, per tet (what a release subtracts).
-    used: Vec<TetTangent>,
-    /// Per tet, whether the coarse matrix holds its blocks at `used` (live at the last
-    /// refresh and not released since).
-    in_coarse: Vec<bool>,
-    /// Steps since the last refresh.
-    since_refresh: u32,
+    level: CoarseLevel,
     /// The assembled Hessian for the Gauss–Seidel smoother (`None`: block Jacobi).
     matrix: Option<BlockMatrix>,
     rhs: Vec<f64>,
@@ -117,17 +85,11 @@ impl NewtonWorkspace {
         params: NewtonParams,
     ) -> Result<Self, CoarseError> {
         let tets = RestTet::all(mesh);
-        let cell = params
-            .coarse_cell
-            .unwrap_or_else(|| 4.0 * mesh.mean_edge_length());
-        let grid = CoarseGrid::new(&mesh.rest_positions, free, cell);
         let inv_h2 = 1.0 / (h * h);
-        let coarse = CoarseSystem::new(&grid, &tets, mass, inv_h2, lame)?;
         let (inc_offsets, inc) = (mesh.node_tet_offsets.clone(), mesh.node_corners());
         let n = mesh.node_count();
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
-        let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
-            .then(|| CoarseAssembly::new(&grid, &tets, &b, coarse.block_index()));
+        let level = CoarseLevel::new(mesh, (&tets, &b), (mass, free), (lame, h), &params)?;
         let evals = TetEvals::at_rest(&tets, &b, lame, lanes);
         let matrix = (params.smoother == Smoother::GaussSeidel).then(|| BlockMatrix::new(n, &tets));
         Ok(NewtonWorkspace {
@@ -145,13 +107,8 @@ impl NewtonWorkspace {
             },
             pre: TwoLevel {
                 diag_inv: vec![Mat3::ZERO; n],
-                rhs: vec![0.0; 3 * grid.count],
-                grid,
-                coarse,
-                assembly,
-                used: Vec::new(),
-                in_coarse: Vec::new(),
-                since_refresh: 0,
+                rhs: vec![0.0; 3 * level.grid.count],
+                level,
                 matrix,
             },
             gradient: vec![Vec3::ZERO; n],
@@ -164,30 +121,14 @@ impl NewtonWorkspace {
 
     /// Coarse nodes and the nonzeros of the coarse matrix's lower triangle.
     pub fn coarse_size(&self) -> (usize, usize) {
-        (self.pre.grid.count, self.pre.coarse.nonzeros())
+        let level = &self.pre.level;
+        (level.grid.count, level.system.nonzeros())
     }
 
-    /// Take released tets (mesh indices) out of the coarse matrix: their rest stiffness
-    /// (before any refresh) or their blocks at the last refresh's tangents.
+    /// Take released tets (mesh indices) out of the coarse matrix
+    /// ([`CoarseLevel::release`]).
     pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
-        let pre = &mut self.pre;
-        if let (Some(assembly), false) = (&pre.assembly, pre.used.is_empty()) {
-            // A tet released by a check earlier in the frame may have been left out of a
-            // refresh since: it is subtracted only if the matrix holds it.
-            let held: Vec<u32> = tets
-                .iter()
-                .copied()
-                .filter(|&t| std::mem::take(&mut pre.in_coarse[t as usize]))
-                .collect();
-            return pre.coarse.release_refreshed(assembly, &held, &pre.used);
-        }
-        let gone: Vec<RestTet> = tets
-            .iter()
-            .map(|&t| self.hessian.tets[t as usize])
-            .collect();
-        self.pre
-            .coarse
-            .release(&self.pre.grid, &gone, self.hessian.lame)
+        self.pre.level.release(tets, &self.hessian.tets)
     }
 
     /// Minimise `G` from `u` (which holds the initial guess, `y` at free nodes and the
@@ -202,11 +143,11 @@ impl NewtonWorkspace {
     ) {
         let mut report = NewtonReport::default();
         let mut g_now = self.hessian.evaluate(u, y, live, free, parallel);
-        if self.refresh_due() {
+        if self.pre.level.refresh_due(&self.last) {
             report.coarse_refreshed = true;
             report.coarse_refresh_failed = self.refresh_coarse(live, parallel).is_err();
         }
-        self.pre.since_refresh += 1;
+        self.pre.level.tick();
         if let Some(m) = &mut self.pre.matrix {
             let h = &self.hessian;
             let mass = |i: usize| h.mass[i] * h.inv_h2;
@@ -275,35 +216,8 @@ impl NewtonWorkspace {
     /// it (the previous factor stays where the new one fails).
     fn refresh_coarse(&mut self, live: &[bool], parallel: bool) -> Result<(), CoarseError> {
         let evals = &self.hessian.evals;
-        let pre = &mut self.pre;
-        // The blocks are these tangents' even where the factor stayed the old one.
-        pre.used.clear();
-        pre.used.extend((0..live.len()).map(|t| evals.tangent(t)));
-        pre.in_coarse.clear();
-        pre.in_coarse.extend_from_slice(live);
-        pre.since_refresh = 0;
-        let used = &pre.used;
-        let tangent = |t: usize| live[t].then(|| &used[t]);
-        let assembly = pre
-            .assembly
-            .as_mut()
-            .expect("a refresh policy has an assembly");
-        pre.coarse.refresh(assembly, tangent, parallel)
-    }
-
-    /// Whether this step re-assembles the coarse matrix (module docs, [`CoarseRefresh`]).
-    fn refresh_due(&self) -> bool {
-        let pre = &self.pre;
-        if pre.assembly.is_none() {
-            return false;
-        }
-        match self.params.coarse_refresh {
-            CoarseRefresh::Rest => false,
-            CoarseRefresh::Steps(n) => pre.since_refresh >= n,
-            CoarseRefresh::Products(bound) => {
-                self.last.cg_products > bound * self.last.iterations.max(1)
-            }
-        }
+        let tangents = (0..live.len()).map(|t| evals.tangent(t));
+        self.pre.level.refresh(tangents, live, parallel)
     }
 
     /// Backtrack along the direction from `u` until `G` decreases enough; on success `u`
@@ -497,9 +411,10 @@ impl TwoLevel {
                 z[i] = self.diag_inv[i] * r[i];
             }
         }
-        self.grid.restrict(r, &mut self.rhs, parallel);
-        self.coarse.solve(&mut self.rhs);
-        self.grid.prolong_add(&self.rhs, z, parallel);
+        let level = &self.level;
+        level.grid.restrict(r, &mut self.rhs, parallel);
+        level.system.solve(&mut self.rhs);
+        level.grid.prolong_add(&self.rhs, z, parallel);
         for (z, f) in z.iter_mut().zip(free) {
             if !f {
                 *z = Vec3::ZERO;
@@ -766,7 +681,7 @@ mod tests {
         released.release(&[5]).unwrap();
         for ws in [&fresh, &released] {
             let mut x = rhs.clone();
-            ws.pre.coarse.solve(&mut x);
+            ws.pre.level.system.solve(&mut x);
             solved.push(x);
         }
         let scale = solved[0].iter().fold(0.0f64, |a, b| a.max(b.abs()));

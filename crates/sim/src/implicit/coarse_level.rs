@@ -1,0 +1,125 @@
+//! The coarse level of the Newton step's two-level preconditioner as the CPU
+//! (`workspace.rs`) and the device (`crate::gpu::newton`) both keep it: the coarse grid,
+//! its Galerkin matrix and factor, the refresh policy and the release rule
+//! (docs/physics-notes.md, "The implicit scheme").
+
+use glam::Vec3;
+
+use super::coarse_assembly::CoarseAssembly;
+use super::coarse_grid::CoarseGrid;
+use super::coarse_system::{CoarseError, CoarseSystem};
+use super::newton_report::NewtonReport;
+use super::params::{CoarseRefresh, NewtonParams};
+use super::rest_tet::RestTet;
+use super::tet_tangent::TetTangent;
+use crate::material::Lame;
+use crate::mesh::TetMesh;
+
+/// The coarse grid, its factorised matrix and what a refresh or a release needs.
+pub struct CoarseLevel {
+    /// Cubes of `coarse_cell` and their interpolation `P`.
+    pub grid: CoarseGrid,
+    /// `A_c`, factorised.
+    pub system: CoarseSystem,
+    /// The tets' corner pairs for re-assembling `system` (`None` under
+    /// [`CoarseRefresh::Rest`]).
+    assembly: Option<CoarseAssembly>,
+    policy: CoarseRefresh,
+    lame: Lame,
+    /// The tangents of the last refresh, per tet (what a release subtracts).
+    used: Vec<TetTangent>,
+    /// Per tet, whether the matrix holds its blocks at `used` (live at the last refresh
+    /// and not released since).
+    in_coarse: Vec<bool>,
+    /// Steps since the last refresh.
+    since_refresh: u32,
+}
+
+impl CoarseLevel {
+    /// The coarse level of `mesh` (its `tets` with shape gradients `b`) for the nodes
+    /// marked `free`, step length `h`: cubes of `coarse_cell` (default four mean rest
+    /// edges), `A_c = Pᵀ(M/h² + K_rest)P` factorised.
+    pub fn new(
+        mesh: &TetMesh,
+        (tets, b): (&[RestTet], &[[Vec3; 4]]),
+        (mass, free): (&[f32], &[bool]),
+        (lame, h): (Lame, f32),
+        params: &NewtonParams,
+    ) -> Result<Self, CoarseError> {
+        let cell = params
+            .coarse_cell
+            .unwrap_or_else(|| 4.0 * mesh.mean_edge_length());
+        let grid = CoarseGrid::new(&mesh.rest_positions, free, cell);
+        let system = CoarseSystem::new(&grid, tets, mass, 1.0 / (h * h), lame)?;
+        let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
+            .then(|| CoarseAssembly::new(&grid, tets, b, system.block_index()));
+        Ok(CoarseLevel {
+            grid,
+            system,
+            assembly,
+            policy: params.coarse_refresh,
+            lame,
+            used: Vec::new(),
+            in_coarse: Vec::new(),
+            since_refresh: 0,
+        })
+    }
+
+    /// Whether the coming step re-assembles the matrix ([`CoarseRefresh`]; `last`: the
+    /// previous step's report).
+    pub fn refresh_due(&self, last: &NewtonReport) -> bool {
+        if self.assembly.is_none() {
+            return false;
+        }
+        match self.policy {
+            CoarseRefresh::Rest => false,
+            CoarseRefresh::Steps(n) => self.since_refresh >= n,
+            CoarseRefresh::Products(bound) => last.cg_products > bound * last.iterations.max(1),
+        }
+    }
+
+    /// One more step since the last refresh.
+    pub fn tick(&mut self) {
+        self.since_refresh += 1;
+    }
+
+    /// Re-assemble the matrix from the `tangents` (one per tet, mesh order) of the tets
+    /// marked `live` and refactorise; on an error (not positive definite) the previous
+    /// factor stays, while the blocks are these tangents'.
+    pub fn refresh(
+        &mut self,
+        tangents: impl Iterator<Item = TetTangent>,
+        live: &[bool],
+        parallel: bool,
+    ) -> Result<(), CoarseError> {
+        self.used.clear();
+        self.used.extend(tangents);
+        self.in_coarse.clear();
+        self.in_coarse.extend_from_slice(live);
+        self.since_refresh = 0;
+        let Some(assembly) = self.assembly.as_mut() else {
+            return Ok(());
+        };
+        let used = &self.used;
+        let tangent = |t: usize| live[t].then(|| &used[t]);
+        self.system.refresh(assembly, tangent, parallel)
+    }
+
+    /// Take released tets (mesh indices; `rest`: every tet) out of the matrix: their rest
+    /// stiffness before any refresh, else their blocks at the last refresh's tangents —
+    /// only those it holds (a tet released by a check earlier in the frame may have been
+    /// left out of a refresh since).
+    pub fn release(&mut self, tets: &[u32], rest: &[RestTet]) -> Result<(), CoarseError> {
+        if let (Some(assembly), false) = (&self.assembly, self.used.is_empty()) {
+            let in_coarse = &mut self.in_coarse;
+            let held: Vec<u32> = tets
+                .iter()
+                .copied()
+                .filter(|&t| std::mem::take(&mut in_coarse[t as usize]))
+                .collect();
+            return self.system.release_refreshed(assembly, &held, &self.used);
+        }
+        let gone: Vec<RestTet> = tets.iter().map(|&t| rest[t as usize]).collect();
+        self.system.release(&self.grid, &gone, self.lame)
+    }
+}

@@ -1,0 +1,22 @@
+//! What one implicit step cost: Newton iterations, products, line-search halvings and
+//! the coarse level's refreshes.
+
+/// What the last implicit step cost.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct NewtonReport {
+    /// Newton iterations taken.
+    pub iterations: u32,
+    /// Hessian–vector products over all iterations.
+    pub cg_products: u32,
+    /// Iterations whose conjugate gradient met non-positive curvature.
+    pub negative_curvature: u32,
+    /// Step halvings of the line search.
+    pub halvings: u32,
+    /// `|∇G|` where the last iteration started (or where the gradient stop ended the step)
+    /// over `|∇G|` at the step's first iterate (free nodes, 2-norm).
+    pub gradient_ratio: f32,
+    /// Whether the coarse matrix was re-assembled from the current tangents this step.
+    pub coarse_refreshed: bool,
+    /// Whether that refresh was not positive definite (the previous factor was kept).
+    pub coarse_refresh_failed: bool,
+}
