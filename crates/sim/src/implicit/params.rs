@@ -93,6 +93,19 @@ impl Default for NewtonParams {
 }
 
 impl NewtonParams {
+    /// The gradient stop for `|∇G| = norm` against the step's first (`first`, set by the
+    /// step's first call): the ratio, and whether Newton stops here.
+    pub fn gradient_stop(&self, first: &mut Option<f64>, norm: f64) -> (f32, bool) {
+        let first = *first.get_or_insert(norm);
+        let ratio = if first > 0.0 {
+            (norm / first) as f32
+        } else {
+            0.0
+        };
+        let stop = norm == 0.0 || norm <= self.gradient_tolerance as f64 * first;
+        (ratio, stop)
+    }
+
     /// Check ranges: the field (under `solver.scheme`) and what is wrong.
     pub fn validate(&self) -> Result<(), (&'static str, String)> {
         if self.steps == 0 || self.steps > 1000 {

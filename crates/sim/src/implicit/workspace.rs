@@ -164,13 +164,9 @@ impl NewtonWorkspace {
                 parallel,
             );
             let norm = dot(&self.gradient, &self.gradient).sqrt();
-            let first = *first_norm.get_or_insert(norm);
-            report.gradient_ratio = if first > 0.0 {
-                (norm / first) as f32
-            } else {
-                0.0
-            };
-            if norm == 0.0 || norm <= self.params.gradient_tolerance as f64 * first {
+            let stop;
+            (report.gradient_ratio, stop) = self.params.gradient_stop(&mut first_norm, norm);
+            if stop {
                 break;
             }
             for (r, g) in self.rhs.iter_mut().zip(&self.gradient) {

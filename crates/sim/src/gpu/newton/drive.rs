@@ -102,14 +102,10 @@ impl GpuNewton {
         let mut enc = encoder(dev);
         let mut first_norm = None;
         for _ in 0..self.params.iterations {
-            let norm = now.grad2.sqrt();
-            let first = *first_norm.get_or_insert(norm);
-            report.gradient_ratio = if first > 0.0 {
-                (norm / first) as f32
-            } else {
-                0.0
-            };
-            if norm == 0.0 || norm <= self.params.gradient_tolerance as f64 * first {
+            let stop;
+            (report.gradient_ratio, stop) =
+                self.params.gradient_stop(&mut first_norm, now.grad2.sqrt());
+            if stop {
                 break;
             }
             let (next, products, negative) = self.conjugate_gradient(dev, enc)?;
