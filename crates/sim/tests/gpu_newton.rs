@@ -118,10 +118,20 @@ fn a_tearing_bar_matches_the_cpu() {
     let mut gpu = GpuSolver::new(bar(), &ctx).expect("upload");
     let (mut cpu_products, mut gpu_products) = (0u64, 0u64);
     let mut first = (None, None);
+    let mut coarse = (0, 0);
     // The first release comes in frame 7, the cascade is over by frame 18.
     for frame in 0..16 {
         let a = cpu.step_frame().unwrap();
         let b = gpu.step_frame().unwrap();
+        // The coarse grid splits where the bar tears, on the device as on the CPU.
+        assert_eq!(
+            a.coarse_nodes, b.coarse_nodes,
+            "frame {frame}: coarse nodes"
+        );
+        coarse = (
+            if frame == 0 { a.coarse_nodes } else { coarse.0 },
+            a.coarse_nodes,
+        );
         cpu_products += a.cg_products as u64;
         gpu_products += b.cg_products as u64;
         for (f, st) in [(&mut first.0, &a), (&mut first.1, &b)] {
@@ -154,6 +164,12 @@ fn a_tearing_bar_matches_the_cpu() {
         first.1
     );
     assert!(cpu.cut().released_count() > 400, "the bar tears through");
+    assert!(
+        coarse.1 > coarse.0,
+        "the coarse grid did not split where the bar tore: {} nodes before, {} after",
+        coarse.0,
+        coarse.1
+    );
     let off = (gpu_products as f64 / cpu_products as f64 - 1.0).abs();
     assert!(
         off <= PRODUCTS,

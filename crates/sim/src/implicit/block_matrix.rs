@@ -164,11 +164,13 @@ impl BlockMatrix {
         evals: &TetEvals,
         definite: bool,
     ) {
-        let (f, cof, mu, mut c, mut s3) = evals.tangent(t).parts();
-        if definite {
-            c = c.max(0.0);
-            s3 = s3.max(-mu / largest_stretch_bound(&f));
-        }
+        let tangent = evals.tangent(t);
+        let tangent = if definite {
+            tangent.definite()
+        } else {
+            tangent
+        };
+        let (f, cof, mu, c, s3) = tangent.parts();
         let scaled = (mu * volume, c * volume, s3 * volume);
         let g = b.map(|b| cof * b);
         let slots = &self.tet_slots[t];
@@ -248,13 +250,4 @@ impl BlockMatrix {
             z[i] -= d_inv[i] * s;
         }
     }
-}
-
-/// `σ̂ ≥ σ_max(F)`, at least 1: the square root of the largest absolute row sum of `FᵀF`
-/// (Gershgorin); exactly 1 at rest.
-#[inline]
-fn largest_stretch_bound(f: &Mat3) -> f32 {
-    let c = f.transpose() * *f;
-    let row = |r: usize| (0..3).map(|k| c.col(k)[r].abs()).sum::<f32>();
-    row(0).max(row(1)).max(row(2)).sqrt().max(1.0)
 }

@@ -1,12 +1,17 @@
 //! The coarse level of the two-level preconditioner: a regular grid of cubes laid over
 //! the body, each free node interpolated trilinearly from the eight corners of its cube
-//! (the prolongation `P`). Only corners that carry enough of the free nodes' weight are
-//! kept, so the coarse unknowns follow the body's shape, not its bounding box.
+//! (the prolongation `P`). A corner is one coarse node per piece of the body it covers
+//! (`coarse_pieces.rs`: split where a cut separates its nodes), and only pieces that carry
+//! enough of the free nodes' weight, with columns of `P` independent of the others', are
+//! kept, so the coarse unknowns follow the body's shape and its cuts, not its bounding box.
 
 use std::collections::HashMap;
 
 use glam::{UVec3, Vec3};
 use rayon::prelude::*;
+
+use super::coarse_pieces::{Pieces, pieces};
+use super::rest_tet::RestTet;
 
 /// The eight corner offsets of a cube, in trilinear order.
 const CORNERS: [UVec3; 8] = [
@@ -40,34 +45,19 @@ pub struct CoarseGrid {
 }
 
 impl CoarseGrid {
-    /// The grid of cubes of edge `cell` over `points`; nodes with `free[i] == false` get no
-    /// weights (their values are fixed, not solved for).
-    pub fn new(points: &[Vec3], free: &[bool], cell: f32) -> Self {
-        let origin = points
-            .iter()
-            .fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p))
-            - Vec3::splat(0.5 * cell);
-        let mut ids: HashMap<UVec3, u32> = HashMap::new();
-        let mut weights = vec![[(0u32, 0.0f32); 8]; points.len()];
-        let mut support: Vec<f32> = Vec::new();
-        for (i, p) in points.iter().enumerate() {
-            if !free[i] {
-                continue;
-            }
-            let g = (*p - origin) / cell;
-            let base = g.floor();
-            let t = g - base;
-            let base = base.as_uvec3();
-            for (k, c) in CORNERS.iter().enumerate() {
-                let next = ids.len() as u32;
-                let id = *ids.entry(base + *c).or_insert(next);
-                support.resize(ids.len(), 0.0);
-                let w = trilinear(t, *c);
-                support[id as usize] += w;
-                weights[i][k] = (id, w);
-            }
-        }
-        let count = prune(&mut weights, &support);
+    /// The grid of cubes of edge `cell` over `points`, one coarse node per piece of the
+    /// body a corner covers (its free nodes connected through the `tets` marked `live`,
+    /// [`pieces`]); nodes with `free[i] == false` get no weights (their values are fixed,
+    /// not solved for).
+    pub fn new(
+        points: &[Vec3],
+        free: &[bool],
+        cell: f32,
+        (tets, live): (&[RestTet], &[bool]),
+    ) -> Self {
+        let mut weights = corner_weights(points, free, cell);
+        let pieces = pieces(&weights, tets, live);
+        let count = prune(&mut weights, &pieces);
         let (transpose_offsets, transpose) = transposed(&weights, count);
         CoarseGrid {
             cell,
@@ -160,23 +150,58 @@ fn transposed(weights: &[NodeWeights], count: usize) -> (Vec<u32>, Vec<(u32, f32
 /// column nearly dependent on its neighbours' and the coarse matrix numerically singular.
 const MIN_SUPPORT: f32 = 0.5;
 
-/// Drop corners supporting less than [`MIN_SUPPORT`], renormalise each node's remaining
-/// weights to sum to 1 (constants still interpolate exactly) and number the kept corners
-/// densely; returns how many are kept.
-fn prune(weights: &mut [NodeWeights], support: &[f32]) -> usize {
-    let mut dense = vec![u32::MAX; support.len()];
-    let mut count = 0u32;
-    for (id, s) in support.iter().enumerate() {
-        if *s >= MIN_SUPPORT {
-            dense[id] = count;
-            count += 1;
+/// Per node, its cube's eight corners (numbered in the order the nodes first reach them)
+/// and trilinear weights; no weights for a node that is not free.
+fn corner_weights(points: &[Vec3], free: &[bool], cell: f32) -> Vec<NodeWeights> {
+    let origin = points
+        .iter()
+        .fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p))
+        - Vec3::splat(0.5 * cell);
+    let mut ids: HashMap<UVec3, u32> = HashMap::new();
+    let mut weights = vec![[(0u32, 0.0f32); 8]; points.len()];
+    for (i, p) in points.iter().enumerate() {
+        if !free[i] {
+            continue;
+        }
+        let g = (*p - origin) / cell;
+        let base = g.floor();
+        let t = g - base;
+        let base = base.as_uvec3();
+        for (k, c) in CORNERS.iter().enumerate() {
+            let next = ids.len() as u32;
+            let id = *ids.entry(base + *c).or_insert(next);
+            weights[i][k] = (id, trilinear(t, *c));
         }
     }
-    for w in weights.iter_mut() {
+    weights
+}
+
+/// Make each piece (`piece`: per weight slot, the first slot of its piece) carrying at
+/// least [`MIN_SUPPORT`] of weight a coarse node, numbered by corner, then by piece; drop
+/// the others, renormalise each node's remaining weights to sum to 1 (constants still
+/// interpolate exactly); returns how many are kept.
+fn prune(weights: &mut [NodeWeights], pieces: &Pieces) -> usize {
+    let piece = &pieces.slot;
+    let slot_weight = |s: usize| weights[s / 8][s % 8];
+    let mut support = vec![0.0f32; piece.len()];
+    for s in 0..piece.len() {
+        support[piece[s] as usize] += slot_weight(s).1;
+    }
+    let mut kept: Vec<usize> = (0..piece.len())
+        .filter(|&s| piece[s] as usize == s && support[s] >= MIN_SUPPORT)
+        .collect();
+    kept.sort_by_key(|&s| (slot_weight(s).0, s));
+    let kept = independent(kept, weights, pieces);
+    let mut dense = vec![u32::MAX; piece.len()];
+    for (n, &s) in kept.iter().enumerate() {
+        dense[s] = n as u32;
+    }
+    for (i, w) in weights.iter_mut().enumerate() {
         let mut total = 0.0;
-        for (id, wk) in w.iter_mut() {
-            if *wk > 0.0 && dense[*id as usize] != u32::MAX {
-                *id = dense[*id as usize];
+        for (k, (id, wk)) in w.iter_mut().enumerate() {
+            let coarse = dense[piece[8 * i + k] as usize];
+            if *wk > 0.0 && coarse != u32::MAX {
+                *id = coarse;
                 total += *wk;
             } else {
                 *id = 0;
@@ -187,7 +212,93 @@ fn prune(weights: &mut [NodeWeights], support: &[f32]) -> usize {
             *wk = if total > 0.0 { *wk / total } else { 0.0 };
         }
     }
-    count as usize
+    kept.len()
+}
+
+/// Least share of a coarse node's column of `P` outside the span of the columns before it
+/// (relative to its squared length) for the node to be kept.
+const MIN_PIVOT: f64 = 1e-3;
+
+/// Most pieces of one fragment whose independence is checked (a dense factorisation of
+/// their Gram matrix, `n²` values and `n³/2` operations); a larger fragment keeps every
+/// piece, as the whole body did before cuts were split.
+const MAX_CHECKED: usize = 1024;
+
+/// The pieces of `kept` (in order) whose columns of `P` are independent of the kept ones
+/// before them, fragment by fragment ([`independent_in`]): a small piece cut off from the
+/// body can be covered by more corners than it has nodes, and their columns are
+/// dependent (the coarse matrix singular). Columns of different fragments share no node.
+fn independent(kept: Vec<usize>, weights: &[NodeWeights], pieces: &Pieces) -> Vec<usize> {
+    let fragment_of = |s: usize| pieces.fragment[s / 8];
+    let mut by_fragment: HashMap<u32, Vec<usize>> = HashMap::new();
+    for &s in &kept {
+        by_fragment.entry(fragment_of(s)).or_default().push(s);
+    }
+    let mut nodes_of: HashMap<u32, Vec<usize>> = HashMap::new();
+    for (i, f) in pieces.fragment.iter().enumerate() {
+        if by_fragment.contains_key(f) {
+            nodes_of.entry(*f).or_default().push(i);
+        }
+    }
+    let mut keep = vec![false; pieces.slot.len()];
+    for (f, group) in by_fragment {
+        let checked = if group.len() <= MAX_CHECKED {
+            independent_in(group, &nodes_of[&f], weights, &pieces.slot)
+        } else {
+            group
+        };
+        for s in checked {
+            keep[s] = true;
+        }
+    }
+    kept.into_iter().filter(|&s| keep[s]).collect()
+}
+
+/// The pieces of `group` (in order) whose columns of `P` are independent of the kept ones
+/// before them: the pivot of a Cholesky factorisation of their Gram matrix `PᵀP` at least
+/// [`MIN_PIVOT`] of its diagonal; `nodes`: the fine nodes of their fragment.
+fn independent_in(
+    group: Vec<usize>,
+    nodes: &[usize],
+    weights: &[NodeWeights],
+    piece: &[u32],
+) -> Vec<usize> {
+    let n = group.len();
+    let at: HashMap<usize, usize> = group.iter().enumerate().map(|(j, &s)| (s, j)).collect();
+    let mut gram = vec![0.0f64; n * n];
+    let mut cols = Vec::with_capacity(8);
+    for &i in nodes {
+        cols.clear();
+        for (k, &(_, wk)) in weights[i].iter().enumerate() {
+            if let (true, Some(&j)) = (wk > 0.0, at.get(&(piece[8 * i + k] as usize))) {
+                cols.push((j, wk as f64));
+            }
+        }
+        for &(a, wa) in &cols {
+            for &(b, wb) in &cols {
+                gram[a * n + b] += wa * wb;
+            }
+        }
+    }
+    // Left-looking Cholesky over the accepted columns: l[j * n + k] = L(j, k).
+    let mut l = vec![0.0f64; n * n];
+    let mut accepted: Vec<usize> = Vec::new();
+    for j in 0..n {
+        for (q, &k) in accepted.iter().enumerate() {
+            let dot: f64 = accepted[..q]
+                .iter()
+                .map(|&m| l[j * n + m] * l[k * n + m])
+                .sum();
+            l[j * n + k] = (gram[j * n + k] - dot) / l[k * n + k];
+        }
+        let done: f64 = accepted.iter().map(|&m| l[j * n + m].powi(2)).sum();
+        let pivot = gram[j * n + j] - done;
+        if pivot >= MIN_PIVOT * gram[j * n + j] {
+            l[j * n + j] = pivot.sqrt();
+            accepted.push(j);
+        }
+    }
+    accepted.into_iter().map(|j| group[j]).collect()
 }
 
 /// The trilinear weight of corner `c` at local coordinates `t` in the cube.
@@ -213,8 +324,9 @@ pub(crate) fn test_block() -> (
     let free: Vec<bool> = (0..mesh.node_count())
         .map(|i| mesh.rest_positions[i].x > 1e-4)
         .collect();
-    let grid = CoarseGrid::new(&mesh.rest_positions, &free, 0.012);
     let tets = super::rest_tet::RestTet::all(&mesh);
+    let live = vec![true; tets.len()];
+    let grid = CoarseGrid::new(&mesh.rest_positions, &free, 0.012, (&tets, &live));
     (mesh, grid, tets)
 }
 
@@ -231,7 +343,7 @@ mod tests {
             })
             .collect();
         let free = vec![true; pts.len()];
-        let grid = CoarseGrid::new(&pts, &free, 0.3);
+        let grid = CoarseGrid::new(&pts, &free, 0.3, (&[], &[]));
         for w in &grid.weights {
             let s: f32 = w.iter().map(|(_, w)| w).sum();
             assert!(s == 0.0 || (s - 1.0).abs() < 1e-5, "{s}");
@@ -264,11 +376,38 @@ mod tests {
     #[test]
     fn fixed_nodes_get_no_weight() {
         let pts = vec![Vec3::ZERO, Vec3::ONE];
-        let grid = CoarseGrid::new(&pts, &[true, false], 0.5);
+        let grid = CoarseGrid::new(&pts, &[true, false], 0.5, (&[], &[]));
         assert!(grid.weights[1].iter().all(|(_, w)| *w == 0.0));
         // The free node sits at the middle of its cube (the grid starts half a cube
         // below the lowest point): each corner carries 1/8, too little to be kept.
         assert_eq!(grid.count, 0);
         assert!(grid.weights[0].iter().all(|(_, w)| *w == 0.0));
+    }
+
+    /// Four nodes at the midpoints of a cube face's edges, one tet: each corner of the
+    /// face carries a weight of 1, but the four columns of `P` are dependent (corners
+    /// A − B + C − D interpolate to zero), as where a piece cut loose covers more corners
+    /// than it has nodes. One corner is dropped and the coarse mass matrix factorises.
+    #[test]
+    fn dependent_corners_are_dropped() {
+        let pts = vec![
+            Vec3::new(0.0, 0.5, 0.0),
+            Vec3::new(0.5, 1.0, 0.0),
+            Vec3::new(1.0, 0.5, 0.0),
+            Vec3::new(0.5, 0.0, 0.0),
+            // Fixed: it only moves the grid's origin so the face lies on grid lines.
+            Vec3::new(-0.5, -0.5, -0.5),
+        ];
+        let free = [true, true, true, true, false];
+        let tet = RestTet {
+            nodes: [0, 1, 2, 3],
+            dm_inv: glam::Mat3::IDENTITY,
+            volume: 1.0,
+        };
+        let grid = CoarseGrid::new(&pts, &free, 1.0, (&[tet], &[true]));
+        assert_eq!(grid.count, 3, "{:?}", grid.weights);
+        let system =
+            super::super::coarse_system::CoarseSystem::mass_only(&grid, &[tet], &[1.0; 5], 1.0);
+        assert!(system.is_ok(), "{:?}", system.err());
     }
 }

@@ -1,12 +1,16 @@
 //! The coarse level of the Newton step's two-level preconditioner as the CPU
 //! (`workspace.rs`) and the device (`crate::gpu::newton`) both keep it: the coarse grid,
-//! its Galerkin matrix and factor, the refresh policy and the release rule
-//! (docs/physics-notes.md, "The implicit scheme").
+//! its Galerkin matrix and factor, the refresh policy, the release rule and the rebuild
+//! after a cut (docs/physics-notes.md, "The implicit scheme", "The coarse level after a
+//! cut").
+
+use std::sync::Arc;
 
 use glam::Vec3;
 
 use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
+use super::coarse_rebuild::{PendingRebuild, RebuildInputs};
 use super::coarse_system::{CoarseError, CoarseSystem};
 use super::newton_report::NewtonReport;
 use super::params::{CoarseRefresh, NewtonParams};
@@ -33,7 +37,20 @@ pub struct CoarseLevel {
     in_coarse: Vec<bool>,
     /// Steps since the last refresh.
     since_refresh: u32,
+    /// What a rebuild of the grid after a cut reads (`None` under [`CoarseRefresh::Rest`]).
+    rebuild_inputs: Option<Arc<RebuildInputs>>,
+    /// The rebuild under way, taken at the next refresh.
+    pending: Option<PendingRebuild>,
+    /// A tet was released since the last rebuild started.
+    cut: bool,
+    /// Most coarse nodes a rebuilt grid may have (a larger one is not taken).
+    max_nodes: usize,
+    /// How many times the grid was rebuilt (what a copy of it, on the device, compares).
+    generation: u32,
 }
+
+/// How many more coarse nodes than the uncut body's a rebuilt grid may have: one half.
+const SPLIT_GROWTH: usize = 2;
 
 impl CoarseLevel {
     /// The coarse level of `mesh` (its `tets` with shape gradients `b`) for the nodes
@@ -49,12 +66,13 @@ impl CoarseLevel {
         let cell = params
             .coarse_cell
             .unwrap_or_else(|| 4.0 * mesh.mean_edge_length());
-        let grid = CoarseGrid::new(&mesh.rest_positions, free, cell);
-        let system = CoarseSystem::new(&grid, tets, mass, 1.0 / (h * h), lame)?;
+        let all = vec![true; tets.len()];
+        let grid = CoarseGrid::new(&mesh.rest_positions, free, cell, (tets, &all));
+        let inv_h2 = 1.0 / (h * h);
+        let system = CoarseSystem::new(&grid, tets, mass, inv_h2, lame)?;
         let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
             .then(|| CoarseAssembly::new(&grid, tets, b, system.block_index()));
         Ok(CoarseLevel {
-            grid,
             system,
             assembly,
             policy: params.coarse_refresh,
@@ -62,7 +80,38 @@ impl CoarseLevel {
             used: Vec::new(),
             in_coarse: Vec::new(),
             since_refresh: 0,
+            rebuild_inputs: (params.coarse_refresh != CoarseRefresh::Rest).then(|| {
+                Arc::new(RebuildInputs {
+                    points: mesh.rest_positions.clone(),
+                    free: free.to_vec(),
+                    mass: mass.to_vec(),
+                    inv_h2,
+                    cell,
+                    tets: tets.to_vec(),
+                    b: b.to_vec(),
+                })
+            }),
+            pending: None,
+            cut: false,
+            max_nodes: grid.count + grid.count / SPLIT_GROWTH,
+            generation: 0,
+            grid,
         })
+    }
+
+    /// Most coarse nodes the grid may come to have after cuts.
+    pub fn max_nodes(&self) -> usize {
+        self.max_nodes
+    }
+
+    /// Lower [`CoarseLevel::max_nodes`] to `max` (what a device allocated room for).
+    pub fn limit_nodes(&mut self, max: usize) {
+        self.max_nodes = self.max_nodes.min(max).max(self.grid.count);
+    }
+
+    /// How many times the grid was rebuilt after a cut.
+    pub fn generation(&self) -> u32 {
+        self.generation
     }
 
     /// Whether the coming step re-assembles the matrix ([`CoarseRefresh`]; `last`: the
@@ -83,17 +132,22 @@ impl CoarseLevel {
         self.since_refresh += 1;
     }
 
-    /// Re-assemble the matrix from the `tangents` (one per tet, mesh order) of the tets
+    /// Re-assemble the matrix from the positive semi-definite part
+    /// ([`TetTangent::definite`]) of the `tangents` (one per tet, mesh order) of the tets
     /// marked `live` and refactorise; on an error (not positive definite) the previous
-    /// factor stays, while the blocks are these tangents'.
+    /// factor stays, while the blocks are these tangents'. First the rebuild started at the
+    /// last refresh is taken, and where tets were released since, the next one starts
+    /// ([`super::coarse_rebuild`]).
     pub fn refresh(
         &mut self,
         tangents: impl Iterator<Item = TetTangent>,
         live: &[bool],
         parallel: bool,
     ) -> Result<(), CoarseError> {
+        let rebuilt = self.take_rebuild();
+        self.start_rebuild(live);
         self.used.clear();
-        self.used.extend(tangents);
+        self.used.extend(tangents.map(|t| t.definite()));
         self.in_coarse.clear();
         self.in_coarse.extend_from_slice(live);
         self.since_refresh = 0;
@@ -102,7 +156,38 @@ impl CoarseLevel {
         };
         let used = &self.used;
         let tangent = |t: usize| live[t].then(|| &used[t]);
-        self.system.refresh(assembly, tangent, parallel)
+        let refreshed = self.system.refresh(assembly, tangent, parallel);
+        rebuilt.and(refreshed)
+    }
+
+    /// Take the rebuild under way, if any: its grid, pattern and assembly replace these
+    /// (the matrix holds the mass alone until the refresh that follows fills it).
+    fn take_rebuild(&mut self) -> Result<(), CoarseError> {
+        let Some(pending) = self.pending.take() else {
+            return Ok(());
+        };
+        if let Some(rebuilt) = pending.take()? {
+            self.grid = rebuilt.grid;
+            self.system = rebuilt.system;
+            self.assembly = Some(rebuilt.assembly);
+            self.generation += 1;
+        }
+        Ok(())
+    }
+
+    /// Start rebuilding on the pieces the tets marked `live` leave, where a tet was
+    /// released since the last rebuild started.
+    fn start_rebuild(&mut self, live: &[bool]) {
+        let Some(inputs) = self.rebuild_inputs.as_ref().filter(|_| self.cut) else {
+            return;
+        };
+        self.cut = false;
+        self.pending = Some(PendingRebuild::start(
+            Arc::clone(inputs),
+            live.to_vec(),
+            self.grid.weights.clone(),
+            self.max_nodes,
+        ));
     }
 
     /// Take released tets (mesh indices; `rest`: every tet) out of the matrix: their rest
@@ -110,6 +195,7 @@ impl CoarseLevel {
     /// only those it holds (a tet released by a check earlier in the frame may have been
     /// left out of a refresh since).
     pub fn release(&mut self, tets: &[u32], rest: &[RestTet]) -> Result<(), CoarseError> {
+        self.cut |= !tets.is_empty();
         if let (Some(assembly), false) = (&self.assembly, self.used.is_empty()) {
             let in_coarse = &mut self.in_coarse;
             let held: Vec<u32> = tets

@@ -9,7 +9,7 @@
 //! rotations and large strains the rest stiffness gets wrong; the fine level corrects the
 //! rest either way: this is only the preconditioner's coarse part.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -28,6 +28,16 @@ use crate::vbd::shape_gradients;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("the coarse level of the implicit solver could not be factorised: {0}")]
 pub struct CoarseError(String);
+
+impl CoarseError {
+    /// An error saying `why`.
+    pub(crate) fn new(why: &str) -> Self {
+        CoarseError(why.to_string())
+    }
+}
+
+/// Block `(row, col)` with row ≥ col → its index among the blocks.
+type BlockIndex = HashMap<(u32, u32), usize>;
 
 /// `A_c` in 3×3 blocks (lower triangle) and its factor.
 pub struct CoarseSystem {
@@ -63,6 +73,49 @@ impl CoarseSystem {
                 add_block(&mut index, &mut blocks, (v, w), &b);
             });
         }
+        Self::with_mass(grid, (index, blocks), mass, inv_h2)
+    }
+
+    /// `Pᵀ (M/h²) P` on the pattern of every pair of coarse nodes a tet of `tets`
+    /// interpolates from, factorised: what a refresh then fills with the tangents.
+    pub fn mass_only(
+        grid: &CoarseGrid,
+        tets: &[RestTet],
+        mass: &[f32],
+        inv_h2: f32,
+    ) -> Result<Self, CoarseError> {
+        let mut sets: HashSet<Vec<u32>> = HashSet::new();
+        for t in tets {
+            let mut ids: Vec<u32> = t
+                .nodes
+                .iter()
+                .flat_map(|&i| grid.weights[i as usize].iter())
+                .filter(|(_, w)| *w != 0.0)
+                .map(|(id, _)| *id)
+                .collect();
+            ids.sort_unstable();
+            ids.dedup();
+            sets.insert(ids);
+        }
+        let mut index = HashMap::new();
+        let mut blocks = Vec::new();
+        for ids in &sets {
+            for (j, &w) in ids.iter().enumerate() {
+                for &v in &ids[j..] {
+                    add_block(&mut index, &mut blocks, (v, w), &Mat3::ZERO);
+                }
+            }
+        }
+        Self::with_mass(grid, (index, blocks), mass, inv_h2)
+    }
+
+    /// The blocks `(index, blocks)` plus the mass part, on their pattern, factorised.
+    fn with_mass(
+        grid: &CoarseGrid,
+        (mut index, mut blocks): (BlockIndex, Vec<[f64; 9]>),
+        mass: &[f32],
+        inv_h2: f32,
+    ) -> Result<Self, CoarseError> {
         for (i, w) in grid.weights.iter().enumerate() {
             node_mass(w, mass[i] * inv_h2, &mut |v, u, b| {
                 add_block(&mut index, &mut blocks, (v, u), &b);

@@ -9,6 +9,8 @@ mod block_matrix;
 mod coarse_assembly;
 mod coarse_grid;
 mod coarse_level;
+mod coarse_pieces;
+mod coarse_rebuild;
 mod coarse_system;
 mod eval_lanes;
 mod newton_report;

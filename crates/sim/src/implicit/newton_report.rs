@@ -19,4 +19,7 @@ pub struct NewtonReport {
     pub coarse_refreshed: bool,
     /// Whether that refresh was not positive definite (the previous factor was kept).
     pub coarse_refresh_failed: bool,
+    /// Coarse nodes after the step: more than the whole body's once a cut has split the
+    /// grid (docs/physics-notes.md, "The coarse level after a cut").
+    pub coarse_nodes: u32,
 }

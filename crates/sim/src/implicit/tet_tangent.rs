@@ -63,6 +63,18 @@ impl TetTangent {
         *df * self.mu + self.cof * (self.c * dj) + cofactor_differential(&self.f, df) * self.s3
     }
 
+    /// This tangent with its indefinite parts cut, `c ≥ 0` and `s₃ ≥ −μ/σ̂` (σ̂ ≥ 1 a
+    /// Gershgorin bound of the largest stretch, [`largest_stretch_bound`]; at rest nothing
+    /// is cut): positive semi-definite, what the preconditioner's matrices hold.
+    #[inline]
+    pub fn definite(&self) -> Self {
+        TetTangent {
+            c: self.c.max(0.0),
+            s3: self.s3.max(-self.mu / largest_stretch_bound(&self.f)),
+            ..*self
+        }
+    }
+
     /// The tangent of the parts [`TetTangent::parts`] gives.
     #[inline]
     pub(crate) fn from_parts(f: Mat3, cof: Mat3, mu: f32, c: f32, s3: f32) -> Self {
@@ -100,6 +112,15 @@ fn cofactor_differential(f: &Mat3, df: &Mat3) -> Mat3 {
         df.z_axis.cross(f.x_axis) + f.z_axis.cross(df.x_axis),
         df.x_axis.cross(f.y_axis) + f.x_axis.cross(df.y_axis),
     )
+}
+
+/// `σ̂ ≥ σ_max(F)`, at least 1: the square root of the largest absolute row sum of `FᵀF`
+/// (Gershgorin); exactly 1 at rest.
+#[inline]
+pub(crate) fn largest_stretch_bound(f: &Mat3) -> f32 {
+    let c = f.transpose() * *f;
+    let row = |r: usize| (0..3).map(|k| c.col(k)[r].abs()).sum::<f32>();
+    row(0).max(row(1)).max(row(2)).sqrt().max(1.0)
 }
 
 #[cfg(test)]

@@ -205,6 +205,7 @@ impl NewtonWorkspace {
                 None => break,
             }
         }
+        report.coarse_nodes = self.pre.level.grid.count as u32;
         self.last = report;
     }
 
@@ -213,7 +214,9 @@ impl NewtonWorkspace {
     fn refresh_coarse(&mut self, live: &[bool], parallel: bool) -> Result<(), CoarseError> {
         let evals = &self.hessian.evals;
         let tangents = (0..live.len()).map(|t| evals.tangent(t));
-        self.pre.level.refresh(tangents, live, parallel)
+        let done = self.pre.level.refresh(tangents, live, parallel);
+        self.pre.rhs.resize(3 * self.pre.level.grid.count, 0.0);
+        done
     }
 
     /// Backtrack along the direction from `u` until `G` decreases enough; on success `u`

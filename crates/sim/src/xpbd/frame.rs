@@ -45,4 +45,7 @@ pub struct FrameStats {
     pub cg_products: u32,
     /// Implicit steps of the frame that re-assembled the coarse matrix (0 under XPBD).
     pub coarse_refreshes: u32,
+    /// Coarse nodes of the implicit scheme's preconditioner at the frame's end (0 under
+    /// XPBD): more than the whole body's once a cut has split the grid.
+    pub coarse_nodes: u32,
 }

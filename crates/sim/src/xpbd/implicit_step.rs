@@ -75,6 +75,7 @@ impl Solver {
                 let r = ws.last;
                 self.implicit_cost.0 += r.cg_products;
                 self.implicit_cost.1 += u32::from(r.coarse_refreshed);
+                self.coarse_nodes = r.coarse_nodes;
                 // A tet pass and a node pass per evaluation, product and gather.
                 self.passes +=
                     2 * (1 + r.iterations + r.halvings) + 2 * r.cg_products + r.iterations;

@@ -93,6 +93,8 @@ pub struct Solver {
     pub(crate) passes: u32,
     /// The last frame's conjugate-gradient products and coarse refreshes (Newton).
     pub(crate) implicit_cost: (u32, u32),
+    /// Coarse nodes after the last implicit step (0 under XPBD).
+    pub(crate) coarse_nodes: u32,
     pub(crate) pool: Option<rayon::ThreadPool>,
     /// The implicit scheme's buffers and preconditioner, built at its first step (when
     /// the pins and grabs are known).
@@ -203,6 +205,7 @@ impl Solver {
             check_ms: 0.0,
             passes: 0,
             implicit_cost: (0, 0),
+            coarse_nodes: 0,
             pool,
             newton: None,
             lame,
@@ -879,6 +882,7 @@ impl Solver {
             passes: self.passes,
             cg_products: self.implicit_cost.0,
             coarse_refreshes: self.implicit_cost.1,
+            coarse_nodes: self.coarse_nodes,
         }
     }
 }

@@ -44,6 +44,24 @@ impl HostCoarse {
         self.level.grid.count
     }
 
+    /// Most coarse nodes the level may come to have after cuts, at most `max` (what the
+    /// device buffers are sized for; [`CoarseLevel::limit_nodes`]).
+    pub fn limit_nodes(&mut self, max: usize) -> usize {
+        self.level.limit_nodes(max);
+        self.level.max_nodes()
+    }
+
+    /// How many times the grid was rebuilt after a cut ([`CoarseLevel::generation`]).
+    pub fn generation(&self) -> u32 {
+        self.level.generation()
+    }
+
+    /// The most `u32`s [`HostCoarse::map`] can come to hold on `fine` nodes with at most
+    /// `coarse` coarse nodes: 16 per fine node, the offsets, two per weight.
+    pub fn map_capacity(fine: usize, coarse: usize) -> usize {
+        16 * fine + coarse + 1 + 2 * 8 * fine
+    }
+
     /// The device's `coarse_map` (layout in newton_cg.wgsl): per fine node its 8 corner
     /// ids then their 8 weights' bits; per coarse node the start of its (fine node,
     /// weight bits) pairs, then one past the last; and where those starts begin.

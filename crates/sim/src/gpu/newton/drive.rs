@@ -96,7 +96,7 @@ impl GpuNewton {
         if let Some(u) = first_iterate {
             report.coarse_refreshed = true;
             report.coarse_refresh_failed = self.coarse.refresh(&u, live).is_err();
-            self.upload_inverse(dev.queue);
+            self.upload_coarse(dev.queue);
         }
         self.coarse.tick();
         let mut enc = encoder(dev);
@@ -119,6 +119,7 @@ impl GpuNewton {
                 None => break,
             }
         }
+        report.coarse_nodes = self.coarse.nodes() as u32;
         self.last = report;
         Ok(enc)
     }

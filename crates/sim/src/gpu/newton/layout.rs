@@ -26,6 +26,10 @@ pub(crate) struct NewtonUniform {
 /// Byte offset of `alpha` in [`NewtonUniform`] (the line search writes it per trial).
 pub(crate) const ALPHA_OFFSET: u64 = 44;
 
+/// Byte offset of `coarse_nodes` in [`NewtonUniform`] (written when a cut rebuilds the
+/// coarse grid).
+pub(crate) const COARSE_NODES_OFFSET: u64 = 8;
+
 /// Slice of `vecs` holding the trial point (`V_TRIAL`).
 pub(crate) const V_TRIAL: u64 = 1;
 /// Slice of `vecs` holding the lumped masses (`V_MASS`).
@@ -105,6 +109,10 @@ mod tests {
         assert_eq!(
             std::mem::offset_of!(NewtonUniform, alpha) as u64,
             ALPHA_OFFSET
+        );
+        assert_eq!(
+            std::mem::offset_of!(NewtonUniform, coarse_nodes) as u64,
+            COARSE_NODES_OFFSET
         );
         let src = include_str!("shaders/newton_common.wgsl");
         for (name, value) in [

@@ -21,7 +21,7 @@ use crate::implicit::{NewtonParams, NewtonReport, Scheme, Smoother};
 use crate::xpbd::{NodeKind, Solver};
 use coarse::HostCoarse;
 use kernels::NewtonKernels;
-use layout::{GROUP, NewtonUniform, Scratch, TET_STRIDE, V_MASS, V_SLICES};
+use layout::{COARSE_NODES_OFFSET, GROUP, NewtonUniform, Scratch, TET_STRIDE, V_MASS, V_SLICES};
 
 /// The XPBD solver's device buffers the Newton kernels read and write too.
 pub(crate) struct Shared<'a> {
@@ -82,6 +82,8 @@ pub(crate) struct GpuNewton {
     /// Products of the last conjugate-gradient solve: how many iterations the next one
     /// records before its first readback.
     cg_hint: u32,
+    /// The coarse grid's generation the device holds ([`HostCoarse::generation`]).
+    generation: u32,
 }
 
 fn storage(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
@@ -142,14 +144,16 @@ impl GpuNewton {
         let (n, slots) = (host.x.len(), host.slots.len());
         let h = host.params.step_length();
         let free: Vec<bool> = host.kind.iter().map(|k| *k == NodeKind::Free).collect();
-        let coarse = HostCoarse::new(mesh, &host.mass, &free, (host.lame, h), &params)?;
+        let mut coarse = HostCoarse::new(mesh, &host.mass, &free, (host.lame, h), &params)?;
         if coarse.nodes() > coarse::MAX_COARSE_NODES {
             return Err(GpuError::CoarseTooLarge {
                 nodes: coarse.nodes(),
                 max: coarse::MAX_COARSE_NODES,
             });
         }
-        let rows = 3 * coarse.nodes();
+        // Room for the grid a cut may split it into (implicit/coarse_rebuild.rs).
+        let capacity = coarse.limit_nodes(coarse::MAX_COARSE_NODES);
+        let rows = 3 * capacity;
         let too_large = |needed: u64| GpuError::TooLarge {
             adapter: adapter.to_string(),
             needed,
@@ -159,6 +163,7 @@ impl GpuNewton {
             V_SLICES * 16 * n as u64,
             TET_STRIDE * 16 * slots as u64,
             4 * (rows * rows) as u64,
+            4 * HostCoarse::map_capacity(n, capacity) as u64,
         ] {
             if needed > max_binding {
                 return Err(too_large(needed));
@@ -168,7 +173,10 @@ impl GpuNewton {
             tet_groups: slots.div_ceil(GROUP as usize),
             node_groups: n.div_ceil(GROUP as usize),
         };
-        let (map, transpose_at) = coarse.map();
+        let (mut map, transpose_at) = coarse.map();
+        map.resize(HostCoarse::map_capacity(n, capacity), 0);
+        let mut ainv = coarse.inverse();
+        ainv.resize(rows * rows, 0.0);
         let inv_h2 = 1.0 / (h * h);
         let uniform = NewtonUniform {
             node_count: n as u32,
@@ -212,11 +220,7 @@ impl GpuNewton {
             inc: storage(device, "newton incidence", bytemuck::cast_slice(&inc)),
             coarse_map: storage(device, "coarse map", bytemuck::cast_slice(&map)),
             coarse_vec: storage(device, "coarse vectors", &vec![0u8; 8 * rows]),
-            ainv: storage(
-                device,
-                "coarse inverse",
-                bytemuck::cast_slice(&coarse.inverse()),
-            ),
+            ainv: storage(device, "coarse inverse", bytemuck::cast_slice(&ainv)),
             scratch: storage(device, "newton scratch", &vec![0u8; 4 * scratch.len()]),
             read_scratch: device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("read newton scratch"),
@@ -271,11 +275,11 @@ impl GpuNewton {
                 ],
             ),
         };
-        Ok(Some(GpuNewton {
+        let newton = GpuNewton {
             groups: (
                 scratch.node_groups as u32,
                 scratch.tet_groups as u32,
-                (rows as u32).div_ceil(GROUP),
+                (3 * coarse.nodes() as u32).div_ceil(GROUP),
             ),
             params,
             kernels,
@@ -288,7 +292,9 @@ impl GpuNewton {
             last: NewtonReport::default(),
             dispatches: 0,
             cg_hint: 8,
-        }))
+            generation: 0,
+        };
+        Ok(Some(newton))
     }
 
     /// Take released tets (mesh indices) out of the coarse level and upload its new
@@ -299,6 +305,25 @@ impl GpuNewton {
             return;
         }
         let _ = self.coarse.release(tets);
+        self.upload_inverse(queue);
+    }
+
+    /// Write the coarse level to the device after a refresh: its grid, where a cut
+    /// rebuilt it (the map, the node count and the coarse workgroups), and its inverse.
+    fn upload_coarse(&mut self, queue: &wgpu::Queue) {
+        let generation = self.coarse.generation();
+        if generation != self.generation {
+            self.generation = generation;
+            let (map, _) = self.coarse.map();
+            queue.write_buffer(&self.buf.coarse_map, 0, bytemuck::cast_slice(&map));
+            let nodes = self.coarse.nodes() as u32;
+            queue.write_buffer(
+                &self.buf.uniform,
+                COARSE_NODES_OFFSET,
+                bytemuck::bytes_of(&nodes),
+            );
+            self.groups.2 = (3 * nodes).div_ceil(GROUP);
+        }
         self.upload_inverse(queue);
     }
 

@@ -73,6 +73,7 @@ impl GpuSolver {
             let r = newton.last;
             self.host.implicit_cost.0 += r.cg_products;
             self.host.implicit_cost.1 += u32::from(r.coarse_refreshed);
+            self.host.coarse_nodes = r.coarse_nodes;
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("newton step end"),
                 timestamp_writes: None,

@@ -1,0 +1,154 @@
+//! The pieces of the body a coarse corner covers: the free nodes it weights, connected
+//! through the edges of the live tets. A corner whose cubes hold both sides of a cut
+//! covers two pieces, and each becomes its own coarse node, so the coarse level never ties
+//! the sides of a cut together (the coarse nodes duplicated per connected piece of a cell,
+//! as in Dick, Georgii & Westermann 2011, "A hexahedral multigrid approach for simulating
+//! cuts in deformable objects"; docs/physics-notes.md, "The coarse level after a cut").
+
+use super::coarse_grid::NodeWeights;
+use super::rest_tet::RestTet;
+
+/// The pieces of every corner and the fragments of the body.
+pub struct Pieces {
+    /// Per weight slot `8 i + k` (node `i`'s corner `k`), the first slot of its piece: the
+    /// slots of one corner joined by a live tet's edge whose two nodes both weight it. A
+    /// slot with no weight is its own piece.
+    pub slot: Vec<u32>,
+    /// Per node, the first node of its fragment: the nodes the live tets connect. A piece
+    /// lies in one fragment.
+    pub fragment: Vec<u32>,
+}
+
+/// The pieces of the corners in `weights` and the fragments the tets marked `live` leave.
+pub fn pieces(weights: &[NodeWeights], tets: &[RestTet], live: &[bool]) -> Pieces {
+    let mut slots = DisjointSets::new(8 * weights.len());
+    let mut nodes = DisjointSets::new(weights.len());
+    for (tet, _) in tets.iter().zip(live).filter(|(_, l)| **l) {
+        for (e, &a) in tet.nodes.iter().enumerate() {
+            nodes.join(a as usize, tet.nodes[(e + 1) % 4] as usize);
+            for &b in &tet.nodes[e + 1..] {
+                join_shared_corners(&mut slots, weights, a as usize, b as usize);
+            }
+        }
+    }
+    Pieces {
+        slot: slots.first_members(),
+        fragment: nodes.first_members(),
+    }
+}
+
+/// Join node `a`'s and node `b`'s slots of every corner both weight.
+fn join_shared_corners(sets: &mut DisjointSets, weights: &[NodeWeights], a: usize, b: usize) {
+    for (ka, &(id, wa)) in weights[a].iter().enumerate() {
+        if wa <= 0.0 {
+            continue;
+        }
+        let shared = weights[b].iter().position(|&(j, wb)| j == id && wb > 0.0);
+        if let Some(kb) = shared {
+            sets.join(8 * a + ka, 8 * b + kb);
+        }
+    }
+}
+
+/// Union–find over `0..n` with path halving.
+struct DisjointSets {
+    parent: Vec<u32>,
+}
+
+impl DisjointSets {
+    /// Every element its own set.
+    fn new(n: usize) -> Self {
+        DisjointSets {
+            parent: (0..n as u32).collect(),
+        }
+    }
+
+    /// The representative of `x`'s set.
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] as usize != x {
+            let grand = self.parent[self.parent[x] as usize];
+            self.parent[x] = grand;
+            x = grand as usize;
+        }
+        x
+    }
+
+    /// Merge the sets of `a` and `b` (the smaller representative stays).
+    fn join(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        let (low, high) = (ra.min(rb), ra.max(rb));
+        self.parent[high] = low as u32;
+    }
+
+    /// Per element, the smallest element of its set.
+    fn first_members(mut self) -> Vec<u32> {
+        (0..self.parent.len())
+            .map(|x| self.find(x) as u32)
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_smallest_member_names_each_set() {
+        let mut s = DisjointSets::new(6);
+        s.join(4, 2);
+        s.join(5, 4);
+        s.join(1, 3);
+        assert_eq!(s.first_members(), vec![0, 1, 2, 1, 2, 2]);
+    }
+}
+
+#[cfg(test)]
+mod cut_tests {
+    use super::super::coarse_grid::{CoarseGrid, test_block};
+    use super::super::coarse_system::CoarseSystem;
+    use super::super::rest_tet::RestTet;
+    use crate::mesh::TetMesh;
+
+    /// The test block's free nodes and its tets marked live unless `released` says so.
+    fn cut(
+        released: impl Fn(&TetMesh, &RestTet) -> bool,
+    ) -> (TetMesh, Vec<RestTet>, Vec<bool>, Vec<bool>) {
+        let (mesh, _, tets) = test_block();
+        let free = (0..mesh.node_count())
+            .map(|i| mesh.rest_positions[i].x > 1e-4)
+            .collect();
+        let live = tets.iter().map(|t| !released(&mesh, t)).collect();
+        (mesh, tets, free, live)
+    }
+
+    /// A cut through the whole block at x = 22.5 mm (between two layers of nodes, inside
+    /// a coarse cube): every coarse node of the split grid interpolates to one side only,
+    /// there are more of them than on the whole block, and the coarse matrix factorises.
+    #[test]
+    fn a_cut_splits_the_corners_it_crosses() {
+        let plane = 0.0225;
+        let (mesh, tets, free, live) = cut(|m, t| {
+            let xs = t.nodes.map(|i| m.rest_positions[i as usize].x);
+            xs.iter().any(|x| *x < plane) && xs.iter().any(|x| *x > plane)
+        });
+        let points = &mesh.rest_positions;
+        let whole = CoarseGrid::new(points, &free, 0.012, (&tets, &vec![true; tets.len()]));
+        let split = CoarseGrid::new(points, &free, 0.012, (&tets, &live));
+        assert!(
+            split.count > whole.count,
+            "{} → {}",
+            whole.count,
+            split.count
+        );
+        let mut side = vec![None; split.count];
+        for (i, w) in split.weights.iter().enumerate() {
+            for &(c, _) in w.iter().filter(|(_, wk)| *wk > 0.0) {
+                let here = points[i].x > plane;
+                let first = *side[c as usize].get_or_insert(here);
+                assert_eq!(first, here, "coarse node {c} spans the cut");
+            }
+        }
+        let mass = mesh.lumped_masses(1040.0);
+        CoarseSystem::mass_only(&split, &tets, &mass, 3600.0).expect("factorises");
+    }
+}
