@@ -96,6 +96,7 @@ impl CoarseAssembly {
         let mut tet_group = Vec::with_capacity(tets.len());
         let mut by_corners: HashMap<Vec<u32>, usize> = HashMap::new();
         let mut members: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
+        let mut ids: Vec<u32> = Vec::with_capacity(MAX_CORNERS);
         for (t, (tet, b)) in tets.iter().zip(b).enumerate() {
             let corners = tet_corners(grid, tet, b);
             beta.extend(corners.iter().map(|c| c.1));
@@ -104,11 +105,16 @@ impl CoarseAssembly {
                 tet_group.push(u32::MAX);
                 continue;
             }
-            let ids: Vec<u32> = corners.iter().map(|c| c.0).collect();
-            let g = *by_corners.entry(ids.clone()).or_insert_with(|| {
-                members.push((ids, Vec::new()));
-                members.len() - 1
-            });
+            ids.clear();
+            ids.extend(corners.iter().map(|c| c.0));
+            let g = match by_corners.get(ids.as_slice()) {
+                Some(&g) => g,
+                None => {
+                    by_corners.insert(ids.clone(), members.len());
+                    members.push((ids.clone(), Vec::new()));
+                    members.len() - 1
+                }
+            };
             members[g].1.push(t as u32);
             tet_group.push(g as u32);
         }

@@ -280,18 +280,25 @@ fn independent_in(
             }
         }
     }
-    // Left-looking Cholesky over the accepted columns: l[j * n + k] = L(j, k).
+    // Left-looking Cholesky over the accepted columns, l[j * n + k] = L(j, k), inside the
+    // envelope: L(j, k) = 0 left of row j's first nonzero of the Gram matrix.
+    let first: Vec<usize> = (0..n)
+        .map(|j| (0..j).find(|&c| gram[j * n + c] != 0.0).unwrap_or(j))
+        .collect();
     let mut l = vec![0.0f64; n * n];
     let mut accepted: Vec<usize> = Vec::new();
     for j in 0..n {
-        for (q, &k) in accepted.iter().enumerate() {
-            let dot: f64 = accepted[..q]
+        let from = accepted.partition_point(|&k| k < first[j]);
+        for q in from..accepted.len() {
+            let k = accepted[q];
+            let start = accepted.partition_point(|&m| m < first[j].max(first[k]));
+            let dot: f64 = accepted[start..q]
                 .iter()
                 .map(|&m| l[j * n + m] * l[k * n + m])
                 .sum();
             l[j * n + k] = (gram[j * n + k] - dot) / l[k * n + k];
         }
-        let done: f64 = accepted.iter().map(|&m| l[j * n + m].powi(2)).sum();
+        let done: f64 = accepted[from..].iter().map(|&m| l[j * n + m].powi(2)).sum();
         let pivot = gram[j * n + j] - done;
         if pivot >= MIN_PIVOT * gram[j * n + j] {
             l[j * n + j] = pivot.sqrt();

@@ -43,7 +43,13 @@ fn join_shared_corners(sets: &mut DisjointSets, weights: &[NodeWeights], a: usiz
         if wa <= 0.0 {
             continue;
         }
-        let shared = weights[b].iter().position(|&(j, wb)| j == id && wb > 0.0);
+        // Nodes of one cube list its corners in the same order.
+        let same = weights[b][ka].0 == id && weights[b][ka].1 > 0.0;
+        let shared = if same {
+            Some(ka)
+        } else {
+            weights[b].iter().position(|&(j, wb)| j == id && wb > 0.0)
+        };
         if let Some(kb) = shared {
             sets.join(8 * a + ka, 8 * b + kb);
         }

@@ -85,17 +85,19 @@ impl CoarseSystem {
         inv_h2: f32,
     ) -> Result<Self, CoarseError> {
         let mut sets: HashSet<Vec<u32>> = HashSet::new();
+        let mut ids = [0u32; 32];
         for t in tets {
-            let mut ids: Vec<u32> = t
-                .nodes
-                .iter()
-                .flat_map(|&i| grid.weights[i as usize].iter())
-                .filter(|(_, w)| *w != 0.0)
-                .map(|(id, _)| *id)
-                .collect();
-            ids.sort_unstable();
-            ids.dedup();
-            sets.insert(ids);
+            let mut n = 0;
+            for &(id, w) in t.nodes.iter().flat_map(|&i| &grid.weights[i as usize]) {
+                if w != 0.0 && !ids[..n].contains(&id) {
+                    ids[n] = id;
+                    n += 1;
+                }
+            }
+            ids[..n].sort_unstable();
+            if !sets.contains(&ids[..n]) {
+                sets.insert(ids[..n].to_vec());
+            }
         }
         let mut index = HashMap::new();
         let mut blocks = Vec::new();
@@ -116,15 +118,12 @@ impl CoarseSystem {
         mass: &[f32],
         inv_h2: f32,
     ) -> Result<Self, CoarseError> {
-        for (i, w) in grid.weights.iter().enumerate() {
-            node_mass(w, mass[i] * inv_h2, &mut |v, u, b| {
-                add_block(&mut index, &mut blocks, (v, u), &b);
-            });
-        }
         let mut mass_blocks = vec![[0.0; 9]; blocks.len()];
         for (i, w) in grid.weights.iter().enumerate() {
             node_mass(w, mass[i] * inv_h2, &mut |v, u, b| {
-                accumulate(&mut mass_blocks[index[&(v, u)]], &b, 1.0);
+                let k = add_block(&mut index, &mut blocks, (v, u), &b);
+                mass_blocks.resize(blocks.len(), [0.0; 9]);
+                accumulate(&mut mass_blocks[k], &b, 1.0);
             });
         }
         let n = 3 * grid.count;
@@ -265,18 +264,19 @@ fn factorise(
     .map_err(|e| CoarseError(format!("{e:?}")))
 }
 
-/// Add `m` to block `(v, w)`, numbering it if it is new.
+/// Add `m` to block `(v, w)`, numbering it if it is new; returns its number.
 fn add_block(
     index: &mut HashMap<(u32, u32), usize>,
     blocks: &mut Vec<[f64; 9]>,
     vw: (u32, u32),
     m: &Mat3,
-) {
+) -> usize {
     let k = *index.entry(vw).or_insert_with(|| {
         blocks.push([0.0; 9]);
         blocks.len() - 1
     });
     accumulate(&mut blocks[k], m, 1.0);
+    k
 }
 
 /// `b += scale · m` in row-major order.
