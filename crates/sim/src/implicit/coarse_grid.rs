@@ -10,6 +10,7 @@ use std::collections::HashMap;
 use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
+pub use super::coarse_pieces::NodeWeights;
 use super::coarse_pieces::{Pieces, pieces};
 use super::rest_tet::RestTet;
 
@@ -24,9 +25,6 @@ const CORNERS: [UVec3; 8] = [
     UVec3::new(0, 1, 1),
     UVec3::new(1, 1, 1),
 ];
-
-/// A fine node's coarse corners and their weights (all zero for a node that is not free).
-pub type NodeWeights = [(u32, f32); 8];
 
 /// The prolongation from coarse corners to fine nodes.
 #[derive(Debug, Clone)]
@@ -416,5 +414,42 @@ mod tests {
         let system =
             super::super::coarse_system::CoarseSystem::mass_only(&grid, &[tet], &[1.0; 5], 1.0);
         assert!(system.is_ok(), "{:?}", system.err());
+    }
+
+    /// A cut through the whole block at x = 22.5 mm (between two layers of nodes, inside
+    /// a coarse cube): every coarse node of the split grid interpolates to one side only,
+    /// there are more of them than on the whole block, and the coarse matrix factorises.
+    #[test]
+    fn a_cut_splits_the_corners_it_crosses() {
+        let plane = 0.0225;
+        let (mesh, _, tets) = test_block();
+        let points = &mesh.rest_positions;
+        let free: Vec<bool> = points.iter().map(|p| p.x > 1e-4).collect();
+        let live: Vec<bool> = tets
+            .iter()
+            .map(|t| {
+                let xs = t.nodes.map(|i| points[i as usize].x);
+                !(xs.iter().any(|x| *x < plane) && xs.iter().any(|x| *x > plane))
+            })
+            .collect();
+        let whole = CoarseGrid::new(points, &free, 0.012, (&tets, &vec![true; tets.len()]));
+        let split = CoarseGrid::new(points, &free, 0.012, (&tets, &live));
+        assert!(
+            split.count > whole.count,
+            "{} → {}",
+            whole.count,
+            split.count
+        );
+        let mut side = vec![None; split.count];
+        for (i, w) in split.weights.iter().enumerate() {
+            for &(c, _) in w.iter().filter(|(_, wk)| *wk > 0.0) {
+                let here = points[i].x > plane;
+                let first = *side[c as usize].get_or_insert(here);
+                assert_eq!(first, here, "coarse node {c} spans the cut");
+            }
+        }
+        let mass = mesh.lumped_masses(1040.0);
+        super::super::coarse_system::CoarseSystem::mass_only(&split, &tets, &mass, 3600.0)
+            .expect("factorises");
     }
 }

@@ -5,8 +5,10 @@
 //! as in Dick, Georgii & Westermann 2011, "A hexahedral multigrid approach for simulating
 //! cuts in deformable objects"; docs/physics-notes.md, "The coarse level after a cut").
 
-use super::coarse_grid::NodeWeights;
 use super::rest_tet::RestTet;
+
+/// A fine node's coarse corners and their weights (all zero for a node that is not free).
+pub type NodeWeights = [(u32, f32); 8];
 
 /// The pieces of every corner and the fragments of the body.
 pub struct Pieces {
@@ -105,56 +107,5 @@ mod tests {
         s.join(5, 4);
         s.join(1, 3);
         assert_eq!(s.first_members(), vec![0, 1, 2, 1, 2, 2]);
-    }
-}
-
-#[cfg(test)]
-mod cut_tests {
-    use super::super::coarse_grid::{CoarseGrid, test_block};
-    use super::super::coarse_system::CoarseSystem;
-    use super::super::rest_tet::RestTet;
-    use crate::mesh::TetMesh;
-
-    /// The test block's free nodes and its tets marked live unless `released` says so.
-    fn cut(
-        released: impl Fn(&TetMesh, &RestTet) -> bool,
-    ) -> (TetMesh, Vec<RestTet>, Vec<bool>, Vec<bool>) {
-        let (mesh, _, tets) = test_block();
-        let free = (0..mesh.node_count())
-            .map(|i| mesh.rest_positions[i].x > 1e-4)
-            .collect();
-        let live = tets.iter().map(|t| !released(&mesh, t)).collect();
-        (mesh, tets, free, live)
-    }
-
-    /// A cut through the whole block at x = 22.5 mm (between two layers of nodes, inside
-    /// a coarse cube): every coarse node of the split grid interpolates to one side only,
-    /// there are more of them than on the whole block, and the coarse matrix factorises.
-    #[test]
-    fn a_cut_splits_the_corners_it_crosses() {
-        let plane = 0.0225;
-        let (mesh, tets, free, live) = cut(|m, t| {
-            let xs = t.nodes.map(|i| m.rest_positions[i as usize].x);
-            xs.iter().any(|x| *x < plane) && xs.iter().any(|x| *x > plane)
-        });
-        let points = &mesh.rest_positions;
-        let whole = CoarseGrid::new(points, &free, 0.012, (&tets, &vec![true; tets.len()]));
-        let split = CoarseGrid::new(points, &free, 0.012, (&tets, &live));
-        assert!(
-            split.count > whole.count,
-            "{} → {}",
-            whole.count,
-            split.count
-        );
-        let mut side = vec![None; split.count];
-        for (i, w) in split.weights.iter().enumerate() {
-            for &(c, _) in w.iter().filter(|(_, wk)| *wk > 0.0) {
-                let here = points[i].x > plane;
-                let first = *side[c as usize].get_or_insert(here);
-                assert_eq!(first, here, "coarse node {c} spans the cut");
-            }
-        }
-        let mass = mesh.lumped_masses(1040.0);
-        CoarseSystem::mass_only(&split, &tets, &mass, 3600.0).expect("factorises");
     }
 }
