@@ -96,12 +96,16 @@ impl CoarseGrid {
         (&self.transpose_offsets, &self.transpose)
     }
 
-    /// `z += P c`: coarse values interpolated onto the fine nodes.
+    /// `z += P c`: coarse values interpolated onto the fine nodes (in f32, each coarse
+    /// value rounded once).
     pub fn prolong_add(&self, c: &[f64], z: &mut [Vec3], parallel: bool) {
+        let c: Vec<Vec3> = c
+            .chunks_exact(3)
+            .map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+            .collect();
         let node = |(w, z): (&NodeWeights, &mut Vec3)| {
             for &(id, wk) in w {
-                let o = 3 * id as usize;
-                *z += wk * Vec3::new(c[o] as f32, c[o + 1] as f32, c[o + 2] as f32);
+                *z += wk * c[id as usize];
             }
         };
         if parallel {
