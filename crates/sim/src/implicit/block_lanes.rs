@@ -103,7 +103,7 @@ pub(super) fn pair_entries<L: Lane>(d: L, ca: V3<L>, y: V3<L>, g: V3<L>) -> [L; 
     ]
 }
 
-/// `σ̂ ≥ σ_max(F)`, at least 1 (block_matrix.rs `largest_stretch_bound`).
+/// `σ̂ ≥ σ_max(F)`, at least 1 (tet_tangent.rs `largest_stretch_bound`).
 #[inline(always)]
 fn largest_stretch_bound<L: Lane>(f: &M3<L>) -> L {
     let c = f.transpose().mul_mat(f);

@@ -6,6 +6,7 @@
 //! cuts in deformable objects"; docs/physics-notes.md, "The coarse level after a cut").
 
 use super::rest_tet::RestTet;
+use crate::mesh::disjoint_sets::DisjointSets;
 
 /// A fine node's coarse corners and their weights (all zero for a node that is not free).
 pub type NodeWeights = [(u32, f32); 8];
@@ -55,57 +56,5 @@ fn join_shared_corners(sets: &mut DisjointSets, weights: &[NodeWeights], a: usiz
         if let Some(kb) = shared {
             sets.join(8 * a + ka, 8 * b + kb);
         }
-    }
-}
-
-/// Union–find over `0..n` with path halving.
-struct DisjointSets {
-    parent: Vec<u32>,
-}
-
-impl DisjointSets {
-    /// Every element its own set.
-    fn new(n: usize) -> Self {
-        DisjointSets {
-            parent: (0..n as u32).collect(),
-        }
-    }
-
-    /// The representative of `x`'s set.
-    fn find(&mut self, mut x: usize) -> usize {
-        while self.parent[x] as usize != x {
-            let grand = self.parent[self.parent[x] as usize];
-            self.parent[x] = grand;
-            x = grand as usize;
-        }
-        x
-    }
-
-    /// Merge the sets of `a` and `b` (the smaller representative stays).
-    fn join(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        let (low, high) = (ra.min(rb), ra.max(rb));
-        self.parent[high] = low as u32;
-    }
-
-    /// Per element, the smallest element of its set.
-    fn first_members(mut self) -> Vec<u32> {
-        (0..self.parent.len())
-            .map(|x| self.find(x) as u32)
-            .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_smallest_member_names_each_set() {
-        let mut s = DisjointSets::new(6);
-        s.join(4, 2);
-        s.join(5, 4);
-        s.join(1, 3);
-        assert_eq!(s.first_members(), vec![0, 1, 2, 1, 2, 2]);
     }
 }

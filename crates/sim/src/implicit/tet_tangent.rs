@@ -117,7 +117,7 @@ fn cofactor_differential(f: &Mat3, df: &Mat3) -> Mat3 {
 /// `σ̂ ≥ σ_max(F)`, at least 1: the square root of the largest absolute row sum of `FᵀF`
 /// (Gershgorin); exactly 1 at rest.
 #[inline]
-pub(crate) fn largest_stretch_bound(f: &Mat3) -> f32 {
+fn largest_stretch_bound(f: &Mat3) -> f32 {
     let c = f.transpose() * *f;
     let row = |r: usize| (0..3).map(|k| c.col(k)[r].abs()).sum::<f32>();
     row(0).max(row(1)).max(row(2)).sqrt().max(1.0)

@@ -3,6 +3,7 @@
 
 mod build;
 mod closest_point;
+pub(crate) mod disjoint_sets;
 mod edges;
 pub mod quality;
 mod surface;

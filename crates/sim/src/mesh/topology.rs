@@ -1,6 +1,7 @@
 //! Connectivity queries over (a subset of) a tet mesh.
 
 use super::TetMesh;
+use super::disjoint_sets::DisjointSets;
 
 /// Number of connected components among the tets for which `live(t)` is true, where two
 /// tets are connected when they share a node (a shared node transmits force in the solver).
@@ -11,24 +12,13 @@ pub fn connected_components(mesh: &TetMesh, live: impl Fn(usize) -> bool) -> usi
 /// Per-tet component label (`u32::MAX` for tets that are not live) and the component count.
 pub fn component_labels(mesh: &TetMesh, live: impl Fn(usize) -> bool) -> (Vec<u32>, usize) {
     let n = mesh.node_count();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn find(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            parent[i as usize] = parent[parent[i as usize] as usize];
-            i = parent[i as usize];
-        }
-        i
-    }
+    let mut sets = DisjointSets::new(n);
     for (t, tet) in mesh.tets.iter().enumerate() {
         if !live(t) {
             continue;
         }
-        let r0 = find(&mut parent, tet[0]);
         for &v in &tet[1..] {
-            let r = find(&mut parent, v);
-            if r != r0 {
-                parent[r as usize] = r0;
-            }
+            sets.join(tet[0] as usize, v as usize);
         }
     }
     let mut label_of_root = vec![u32::MAX; n];
@@ -38,7 +28,7 @@ pub fn component_labels(mesh: &TetMesh, live: impl Fn(usize) -> bool) -> (Vec<u3
         if !live(t) {
             continue;
         }
-        let r = find(&mut parent, tet[0]) as usize;
+        let r = sets.find(tet[0] as usize);
         if label_of_root[r] == u32::MAX {
             label_of_root[r] = count;
             count += 1;

@@ -6,6 +6,7 @@ use std::collections::{HashMap, HashSet};
 
 use crate::mass_spring::MassSpringModel;
 use crate::mesh::TET_FACES;
+use crate::mesh::disjoint_sets::DisjointSets;
 
 /// What the separation did.
 #[derive(Debug, Clone, Default)]
@@ -88,14 +89,7 @@ pub(crate) fn separate(
 /// not `marked`; parts ordered by their lowest tet index.
 fn star_components(model: &MassSpringModel, v: u32, marked: &HashSet<(u32, u8)>) -> Vec<Vec<u32>> {
     let star: Vec<u32> = model.node_tets[v as usize].clone();
-    let mut parent: Vec<usize> = (0..star.len()).collect();
-    fn find(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
+    let mut sets = DisjointSets::new(star.len());
     let mut seen: HashMap<[u32; 2], usize> = HashMap::new();
     for (s, &t) in star.iter().enumerate() {
         let tet = model.tets[t as usize];
@@ -113,12 +107,7 @@ fn star_components(model: &MassSpringModel, v: u32, marked: &HashSet<(u32, u8)>)
             }
             key.sort_unstable();
             match seen.get(&key) {
-                Some(&other) => {
-                    let (ra, rb) = (find(&mut parent, s), find(&mut parent, other));
-                    if ra != rb {
-                        parent[ra.max(rb)] = ra.min(rb);
-                    }
-                }
+                Some(&other) => sets.join(s, other),
                 None => {
                     seen.insert(key, s);
                 }
@@ -127,7 +116,7 @@ fn star_components(model: &MassSpringModel, v: u32, marked: &HashSet<(u32, u8)>)
     }
     let mut groups: HashMap<usize, Vec<u32>> = HashMap::new();
     for (s, &t) in star.iter().enumerate() {
-        let r = find(&mut parent, s);
+        let r = sets.find(s);
         groups.entry(r).or_default().push(t);
     }
     let mut parts: Vec<Vec<u32>> = groups.into_values().collect();
