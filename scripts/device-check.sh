@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # One short check for a machine with a real GPU (issue 17): the GPU tests, the realtime
-# benchmark of the default scene (34k tets) on the GPU (a dispatch per colour, and the
-# partitioned order's dispatch per phase) and the CPU, the same organ on the implicit
-# scheme on the GPU (issue 31: its dispatches a frame), the solver benchmark
+# benchmark of the default organ (34k tets) on XPBD on the GPU (a dispatch per colour, and
+# the partitioned order's dispatch per phase), the default scene (that organ on the
+# implicit scheme, issue 31: its ms and dispatches a frame) on the GPU and the CPU, the
+# solver benchmark
 # up to ≥ 1M tets on the GPU, and a CPU/GPU parity run, written as one JSON object to
 # ${OUT:-.}/device-check.json (stdout and stderr of each step beside it). Under 5 minutes
 # on a datacentre GPU once built; the build itself is not timed.
@@ -33,9 +34,9 @@ step() {
 }
 
 step gpu_tests cargo test --release --locked -p incise-sim --test gpu_parity --test gpu_validation --test gpu_newton
-step realtime_gpu "$bin" bench realtime --device gpu --frames 60 --json
-step realtime_gpu_blocks "$bin" bench realtime --device gpu --cpu-sweep blocks --frames 60 --json
-step realtime_gpu_newton "$bin" bench realtime --scene config/intestine_pull_newton.ron --device gpu --frames 60 --json
+step realtime_gpu "$bin" bench realtime --scene config/intestine_pull_xpbd.ron --device gpu --frames 60 --json
+step realtime_gpu_blocks "$bin" bench realtime --scene config/intestine_pull_xpbd.ron --device gpu --cpu-sweep blocks --frames 60 --json
+step realtime_gpu_newton "$bin" bench realtime --device gpu --frames 60 --json
 step realtime_cpu "$bin" bench realtime --device cpu --frames 10 --json
 step scaling_gpu "$bin" bench solver --device gpu --case intestine --scaling --frames 5 --json
 step parity "$bin" compare config/intestine_pull.ron --frames 20 --json

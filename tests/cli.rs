@@ -418,14 +418,14 @@ fn the_implicit_scheme_runs_on_either_device_and_checks_its_settings() {
             dir.join(out).to_str().unwrap(),
         ])
     };
-    let o = run("config/intestine_pull_newton.ron", "auto", "auto");
+    let o = run("config/intestine_pull.ron", "auto", "auto");
     assert!(o.status.success(), "{}", text(&o.stderr));
     let r: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("auto/report.json")).unwrap()).unwrap();
     let choice = r["device_choice"].as_str().unwrap();
     assert!(choice.starts_with("--device auto: "), "{r}");
     if incise_xr::RenderDevice::headless().is_ok() {
-        let o = run("config/intestine_pull_newton.ron", "gpu", "gpu");
+        let o = run("config/intestine_pull.ron", "gpu", "gpu");
         assert!(o.status.success(), "{}", text(&o.stderr));
         let r: serde_json::Value =
             serde_json::from_slice(&std::fs::read(dir.join("gpu/report.json")).unwrap()).unwrap();

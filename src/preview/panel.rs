@@ -340,10 +340,29 @@ impl Panel {
             ui,
             egui::Slider::new(&mut d.damping, 0.0..=50.0).text("damping (1/s)"),
         );
-        done |= slider(
-            ui,
-            egui::Slider::new(&mut d.substeps, 1..=400).text("substeps"),
-        );
+        ui.horizontal(|ui| {
+            ui.label("scheme");
+            for (implicit, name) in [(false, "XPBD"), (true, "implicit (Newton)")] {
+                done |= ui
+                    .selectable_value(&mut d.implicit, implicit, name)
+                    .clicked();
+            }
+        });
+        if d.implicit {
+            done |= slider(
+                ui,
+                egui::Slider::new(&mut d.newton.iterations, 1..=20).text("Newton iterations"),
+            );
+            done |= slider(
+                ui,
+                egui::Slider::new(&mut d.newton.cg_iterations, 5..=400).text("CG products a solve"),
+            );
+        } else {
+            done |= slider(
+                ui,
+                egui::Slider::new(&mut d.substeps, 1..=400).text("substeps"),
+            );
+        }
         let mut cutting = d.cut_threshold.is_some();
         let toggled = ui.checkbox(&mut cutting, "cutting").changed();
         done |= toggled;

@@ -50,8 +50,8 @@ pub const FILES: &[(&str, &str)] = &[
         include_str!("../../config/intestine_pull.ron"),
     ),
     (
-        "intestine_pull_newton.ron",
-        include_str!("../../config/intestine_pull_newton.ron"),
+        "intestine_pull_xpbd.ron",
+        include_str!("../../config/intestine_pull_xpbd.ron"),
     ),
     ("materials.ron", include_str!("../../config/materials.ron")),
     (

@@ -1,9 +1,11 @@
 //! The settings of a body a user may change while it runs (the preview's material and
-//! solver panel): the XPBD material, damping, substeps and cut rule. A body that has them
+//! solver panel): the XPBD material, damping, time integrator (XPBD substeps or the
+//! implicit scheme's Newton iterations) and cut rule. A body that has them
 //! ([`crate::sim_body::SimBody::tunables`]) applies new ones to its live state, motion,
 //! cut and grabs carried over ([`crate::sim_body::SimBody::retune`]).
 
 use incise_sim::contact::CutZone;
+use incise_sim::implicit::NewtonParams;
 
 /// Settings a running body takes without starting over.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -22,8 +24,12 @@ pub struct Tunables {
     /// The zone "only along the blade's edge" gives (the scene's own `NearEdge`, else
     /// [`crate::scene::hand_tool::edge_zone`] for this mesh; not editable).
     pub edge_zone: CutZone,
-    /// Substeps per frame.
+    /// Substeps per frame (XPBD).
     pub substeps: u32,
+    /// Whether the body runs the implicit scheme (`newton`) rather than XPBD (`substeps`).
+    pub implicit: bool,
+    /// The implicit scheme's settings: the scene's own, else the defaults.
+    pub newton: NewtonParams,
     /// The Poisson ratios the scene's constraint pair can represent (not editable).
     pub poisson_range: (f32, f32),
 }

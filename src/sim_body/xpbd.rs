@@ -9,6 +9,7 @@ use anyhow::{Result, bail};
 use glam::{Quat, Vec3};
 use incise_sim::contact::{CutZone, ToolPose};
 use incise_sim::gpu::GpuContext;
+use incise_sim::implicit::{NewtonParams, Scheme};
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::skin::Skin;
 use incise_sim::xpbd::SolverError;
@@ -428,7 +429,7 @@ impl SimBody for XpbdBody {
 
     fn substeps(&self) -> Option<Substeps> {
         // The implicit scheme steps a frame its own way: it has no substeps to cut.
-        if self.body.solver().params().scheme != incise_sim::implicit::Scheme::Xpbd {
+        if self.body.solver().params().scheme != Scheme::Xpbd {
             return None;
         }
         Some(Substeps {
@@ -480,6 +481,11 @@ impl SimBody for XpbdBody {
                 own => own,
             },
             substeps: p.substeps,
+            implicit: p.scheme != Scheme::Xpbd,
+            newton: match p.scheme {
+                Scheme::Newton(n) => n,
+                Scheme::Xpbd => NewtonParams::default(),
+            },
             poisson_range: p.poisson_range(),
         })
     }
@@ -495,6 +501,10 @@ impl SimBody for XpbdBody {
         params.release_threshold = t.cut_threshold;
         params.cut_zone = t.cut_zone;
         params.substeps = t.substeps;
+        params.scheme = match t.implicit {
+            true => Scheme::Newton(t.newton),
+            false => Scheme::Xpbd,
+        };
         self.rebuild(material, params, device)
     }
 
@@ -689,6 +699,70 @@ mod tests {
             apart < 0.01 * moved,
             "a 0.1 % damping change moved the body {apart} m of {moved}"
         );
+    }
+
+    /// The panel's scheme switch during a pull: the body goes on on the implicit scheme
+    /// from where XPBD had taken it (frame count, grab and motion carried over), lands
+    /// where XPBD goes (the plate's pull is converged on both), and switches back.
+    #[test]
+    fn the_scheme_switches_mid_pull_and_back() {
+        let (mut xpbd, mut switched) = (
+            hand_body("config/plate_stretch.ron"),
+            hand_body("config/plate_stretch.ron"),
+        );
+        let run = |b: &mut XpbdBody, frames: usize| {
+            for _ in 0..frames {
+                b.step(&ToolInput::Script).unwrap();
+            }
+        };
+        run(&mut xpbd, 20);
+        run(&mut switched, 20);
+        let own = switched.tunables().unwrap();
+        assert!(!own.implicit, "plate_stretch runs XPBD");
+        let implicit = Tunables {
+            implicit: true,
+            ..own
+        };
+        switched.retune(implicit, DeviceChoice::Cpu).unwrap();
+        assert!(matches!(
+            switched.body.solver().params().scheme,
+            Scheme::Newton(_)
+        ));
+        assert_eq!(switched.substeps(), None, "no substeps to pace");
+        assert_eq!(
+            switched.body.solver().frame(),
+            20,
+            "the frame count goes on"
+        );
+        run(&mut xpbd, 20);
+        run(&mut switched, 20);
+        let (a, b) = (xpbd.body.solver(), switched.body.solver());
+        let largest = |d: &mut dyn Iterator<Item = f32>| d.fold(0.0f32, f32::max);
+        let rest = &a.mesh().rest_positions;
+        let moved = largest(
+            &mut a
+                .positions()
+                .iter()
+                .zip(rest)
+                .map(|(p, r)| (*p - *r).length()),
+        );
+        let apart = largest(
+            &mut a
+                .positions()
+                .iter()
+                .zip(b.positions())
+                .map(|(p, q)| (*p - *q).length()),
+        );
+        eprintln!("moved {moved} m, apart {apart} m");
+        assert!(moved > 1e-3, "the grab pulls the plate: {moved} m");
+        assert!(
+            apart < 0.05 * moved,
+            "on the implicit scheme the plate is {apart} m from XPBD's of {moved}"
+        );
+        switched.retune(own, DeviceChoice::Cpu).unwrap();
+        assert_eq!(switched.body.solver().params().scheme, Scheme::Xpbd);
+        assert_eq!(switched.tunables().unwrap(), own);
+        run(&mut switched, 1);
     }
 
     /// "Only along the blade's edge" on a tearing scene: with the edge zone the grab
