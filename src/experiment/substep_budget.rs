@@ -392,11 +392,12 @@ fn scheme_name(s: &Scheme) -> String {
     match s {
         Scheme::Xpbd => s.name().into(),
         Scheme::Newton(p) => format!(
-            "{}: {} step(s), ≤ {} iterations (until the gradient is down to {}), ≤ {} CG products to {}",
+            "{}: {} step(s), ≤ {} iterations (until the gradient is down to {} or a step moves ≤ {} of an edge), ≤ {} CG products to {}",
             s.name(),
             p.steps,
             p.iterations,
             p.gradient_tolerance,
+            p.step_tolerance,
             p.cg_iterations,
             p.cg_tolerance
         ),

@@ -26,6 +26,7 @@ const CONVERGED: NewtonParams = NewtonParams {
     cg_iterations: 200,
     cg_tolerance: 1e-3,
     gradient_tolerance: 1e-4,
+    step_tolerance: 0.0,
     coarse_cell: None,
     coarse_refresh: CoarseRefresh::Steps(2),
     smoother: Smoother::Jacobi,
@@ -92,6 +93,61 @@ fn a_bending_cantilever_matches_the_cpu() {
     assert!(
         off <= PRODUCTS,
         "products {gpu_products} on the device against {cpu_products} on the CPU"
+    );
+}
+
+/// The step stop on the device: the falling cantilever with the gradient stop out of
+/// reach ends its Newton iterations where the CPU's do, once a step moved no node more
+/// than 1 % of an edge (the device reduces the direction's largest node move in the line
+/// search's trial kernel), well before the iteration budget.
+#[test]
+fn the_step_stop_ends_newton_as_on_the_cpu() {
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
+    let beam = || {
+        let mesh = common::block_mesh(
+            Vec3::new(0.0, -0.01, -0.01),
+            Vec3::new(0.1, 0.02, 0.02),
+            UVec3::new(10, 2, 2),
+        );
+        let params = SolverParams {
+            scheme: Scheme::Newton(NewtonParams {
+                iterations: 8,
+                gradient_tolerance: 1e-6,
+                step_tolerance: 0.01,
+                ..CONVERGED
+            }),
+            damping: 5.0,
+            threads: 1,
+            ..SolverParams::default()
+        };
+        let mut s = Solver::new(mesh, common::soft(1e5, 0.45), params).unwrap();
+        let root: Vec<u32> = (0..s.mesh().node_count() as u32)
+            .filter(|&i| s.mesh().rest_positions[i as usize].x < 1e-4)
+            .collect();
+        s.pin(&root);
+        s
+    };
+    let mut cpu = beam();
+    let mut gpu = GpuSolver::new(beam(), &ctx).expect("upload");
+    let frames = 20;
+    let (mut on_cpu, mut on_gpu, mut differ) = (0, 0, 0);
+    for _ in 0..frames {
+        cpu.step_frame().unwrap();
+        gpu.step_frame().unwrap();
+        let a = cpu.newton_report().unwrap().iterations;
+        let b = gpu.newton_report().unwrap().iterations;
+        (on_cpu, on_gpu) = (on_cpu + a, on_gpu + b);
+        differ += u32::from(a != b);
+    }
+    assert!(
+        on_cpu < 6 * frames,
+        "the step stop ends the CPU's iterations early: {on_cpu} in {frames} frames"
+    );
+    assert!(
+        differ <= 2 && on_gpu.abs_diff(on_cpu) <= 2,
+        "Newton iterations: {on_gpu} on the device, {on_cpu} on the CPU ({differ} frames differ)"
     );
 }
 

@@ -19,6 +19,7 @@ const CONVERGED: NewtonParams = NewtonParams {
     cg_iterations: 200,
     cg_tolerance: 1e-3,
     gradient_tolerance: 0.0,
+    step_tolerance: 0.0,
     coarse_cell: None,
     coarse_refresh: CoarseRefresh::Rest,
     smoother: Smoother::Jacobi,
@@ -74,6 +75,57 @@ fn a_cantilever_settles_on_the_static_solution_of_its_mesh() {
     assert!(
         report.iterations >= 1 && report.cg_products >= 1,
         "{report:?}"
+    );
+}
+
+/// The step stop (`step_tolerance`): a stiff cantilever sagging to rest under gravity,
+/// with the gradient stop out of reach (1e-6), needs far fewer Newton iterations when
+/// Newton also stops after a step that moved no node more than 1 % of an edge, and ends
+/// where the run without it ends, within that 1 % of an edge.
+#[test]
+fn newton_stops_once_its_steps_are_short() {
+    let mesh = common::block_mesh(
+        Vec3::new(0.0, -0.01, -0.01),
+        Vec3::new(0.2, 0.02, 0.02),
+        UVec3::new(20, 2, 2),
+    );
+    let edge = mesh.mean_edge_length();
+    let run = |step_tolerance| {
+        let params = SolverParams {
+            scheme: Scheme::Newton(NewtonParams {
+                iterations: 8,
+                gradient_tolerance: 1e-6,
+                step_tolerance,
+                ..NewtonParams::default()
+            }),
+            damping: 20.0,
+            threads: 1,
+            ..SolverParams::default()
+        };
+        let mut s = Solver::new(mesh.clone(), common::soft(3e6, 0.45), params).unwrap();
+        let root: Vec<u32> = (0..mesh.node_count() as u32)
+            .filter(|&i| mesh.rest_positions[i as usize].x < 1e-4)
+            .collect();
+        s.pin(&root);
+        let mut iterations = 0;
+        for _ in 0..60 {
+            s.step_frame().unwrap();
+            iterations += s.newton_report().unwrap().iterations;
+        }
+        (s, iterations)
+    };
+    let (full, full_iterations) = run(0.0);
+    let (short, short_iterations) = run(0.01);
+    let gap = common::worst_gap(full.positions(), short.positions());
+    let sag = common::max_displacement(&full);
+    assert!(sag > 0.005, "the beam sags: {sag} m");
+    assert!(
+        (short_iterations as f64) < 0.6 * full_iterations as f64,
+        "{short_iterations} Newton iterations with the step stop, {full_iterations} without"
+    );
+    assert!(
+        gap <= 0.01 * edge,
+        "the step stop ends {gap:e} m from the full solve (edge {edge:e} m)"
     );
 }
 
@@ -236,6 +288,14 @@ fn unusable_newton_settings_are_refused() {
         ..SolverParams::default()
     };
     assert!(try_with(bad_tolerance).contains("solver.scheme.cg_tolerance"));
+    let backwards = SolverParams {
+        scheme: Scheme::Newton(NewtonParams {
+            step_tolerance: -0.01,
+            ..NewtonParams::default()
+        }),
+        ..SolverParams::default()
+    };
+    assert!(try_with(backwards).contains("solver.scheme.step_tolerance"));
     let never = SolverParams {
         scheme: Scheme::Newton(NewtonParams {
             coarse_refresh: CoarseRefresh::Steps(0),

@@ -62,6 +62,8 @@ struct TwoLevel {
 /// Buffers and the preconditioner of the implicit scheme for one body.
 pub struct NewtonWorkspace {
     params: NewtonParams,
+    /// The mesh's mean rest edge, m (the step stop's unit).
+    mean_edge: f32,
     hessian: Hessian,
     pre: TwoLevel,
     gradient: Vec<Vec3>,
@@ -94,6 +96,7 @@ impl NewtonWorkspace {
         let matrix = (params.smoother == Smoother::GaussSeidel).then(|| BlockMatrix::new(n, &tets));
         Ok(NewtonWorkspace {
             params,
+            mean_edge: mesh.mean_edge_length(),
             hessian: Hessian {
                 b,
                 evals,
@@ -201,7 +204,13 @@ impl NewtonWorkspace {
                 break;
             }
             match self.line_search(u, y, live, free, g_now, slope, parallel, &mut report) {
-                Some(g) => g_now = g,
+                Some((g, alpha)) => {
+                    g_now = g;
+                    let moved = alpha * reach(&self.direction, free);
+                    if self.params.step_stop(moved, self.mean_edge) {
+                        break;
+                    }
+                }
                 None => break,
             }
         }
@@ -221,7 +230,8 @@ impl NewtonWorkspace {
 
     /// Backtrack along the direction from `u` until `G` decreases enough; on success `u`
     /// moves there and the tet evaluations are the new point's, else `u` stays and they
-    /// are `u`'s again. Returns the new `G`. The full step is evaluated in full (it is
+    /// are `u`'s again. Returns the new `G` and the step's length along the direction. The
+    /// full step is evaluated in full (it is
     /// usually taken); a halved one only for its energy, and in full once taken.
     #[allow(clippy::too_many_arguments)]
     fn line_search(
@@ -234,7 +244,7 @@ impl NewtonWorkspace {
         slope: f64,
         parallel: bool,
         report: &mut NewtonReport,
-    ) -> Option<f64> {
+    ) -> Option<(f64, f32)> {
         let mut alpha = 1.0f32;
         // f32 energies summed in f64: changes below this are rounding.
         let rounding = 1e-6 * g_now.abs();
@@ -252,7 +262,7 @@ impl NewtonWorkspace {
                     self.hessian.evaluate(&self.trial, y, live, free, parallel);
                 }
                 u.copy_from_slice(&self.trial);
-                return Some(g_trial);
+                return Some((g_trial, alpha));
             }
             alpha *= 0.5;
             report.halvings += 1;
@@ -260,6 +270,16 @@ impl NewtonWorkspace {
         self.hessian.evaluate(u, y, live, free, parallel);
         None
     }
+}
+
+/// The furthest a free node moves along `d`, m.
+fn reach(d: &[Vec3], free: &[bool]) -> f32 {
+    d.iter()
+        .zip(free)
+        .filter(|(_, f)| **f)
+        .map(|(d, _)| d.length_squared())
+        .fold(0.0, f32::max)
+        .sqrt()
 }
 
 impl Hessian {

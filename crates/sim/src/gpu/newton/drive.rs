@@ -45,6 +45,8 @@ struct Sums {
     grad2: f64,
     /// `∇G · d` at the current iterate (after a trial point).
     slope: f64,
+    /// The furthest a free node moves along `d`, m (after a trial point).
+    reach: f32,
 }
 
 /// One dispatch: pipeline, group 0, workgroups.
@@ -115,7 +117,12 @@ impl GpuNewton {
             let (next, taken) = self.line_search(dev, next, now.g, &mut report)?;
             enc = next;
             match taken {
-                Some(sums) => now = sums,
+                Some((sums, moved)) => {
+                    now = sums;
+                    if self.params.step_stop(moved, self.mean_edge) {
+                        break;
+                    }
+                }
                 None => break,
             }
         }
@@ -176,8 +183,8 @@ impl GpuNewton {
 
     /// Backtrack along the direction from the iterate until `G` decreases enough (as
     /// `NewtonWorkspace::line_search`): the full step is evaluated in full, a halved one
-    /// for its energy only and in full once taken. Returns the sums at the point taken, or
-    /// `None` (the iterate stays) when the direction does not descend or no halving
+    /// for its energy only and in full once taken. Returns the sums at the point taken and
+    /// how far the step moved the furthest free node, or `None` (the iterate stays) when the direction does not descend or no halving
     /// decreased `G`.
     fn line_search(
         &mut self,
@@ -185,11 +192,11 @@ impl GpuNewton {
         mut enc: wgpu::CommandEncoder,
         g_now: f64,
         report: &mut NewtonReport,
-    ) -> Result<(wgpu::CommandEncoder, Option<Sums>), GpuError> {
+    ) -> Result<(wgpu::CommandEncoder, Option<(Sums, f32)>), GpuError> {
         let mut alpha = 1.0f32;
         // f32 energies summed in f64 on the host: changes below this are rounding.
         let rounding = 1e-6 * g_now.abs();
-        let mut slope = 0.0;
+        let (mut slope, mut reach) = (0.0, 0.0);
         for halving in 0..=MAX_HALVINGS {
             dev.queue
                 .write_buffer(&self.buf.uniform, ALPHA_OFFSET, bytemuck::bytes_of(&alpha));
@@ -213,7 +220,7 @@ impl GpuNewton {
             enc = encoder(dev);
             let mut at = self.sums(&s);
             if halving == 0 {
-                slope = at.slope;
+                (slope, reach) = (at.slope, at.reach);
                 if slope >= 0.0 {
                     return Ok((enc, None));
                 }
@@ -231,7 +238,7 @@ impl GpuNewton {
                 }
                 let n = self.node_count as u64;
                 enc.copy_buffer_to_buffer(&self.buf.vecs, V_TRIAL * n * 16, dev.pos, 0, n * 16);
-                return Ok((enc, Some(at)));
+                return Ok((enc, Some((at, alpha * reach))));
             }
             alpha *= 0.5;
             report.halvings += 1;
@@ -249,6 +256,7 @@ impl GpuNewton {
             g: sum(sc.tet_energy()) + 0.5 * self.inv_h2 as f64 * sum(sc.inertia()),
             grad2: sum(sc.grad2()),
             slope: sum(sc.slope()),
+            reach: s[sc.reach()].iter().fold(0.0f32, |a, &b| a.max(b)).sqrt(),
         }
     }
 

@@ -83,9 +83,13 @@ impl Scratch {
     pub fn slope(&self) -> std::ops::Range<usize> {
         self.node(4)
     }
+    /// Per workgroup the largest `|d|²` of a free node (the line search's direction).
+    pub fn reach(&self) -> std::ops::Range<usize> {
+        self.node(5)
+    }
     /// The conjugate gradient's state.
     pub fn state(&self) -> usize {
-        self.tet_groups + 5 * self.node_groups
+        self.tet_groups + 6 * self.node_groups
     }
     /// Words in all.
     pub fn len(&self) -> usize {

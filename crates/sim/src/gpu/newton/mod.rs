@@ -74,6 +74,8 @@ pub(crate) struct GpuNewton {
     /// Workgroups of a node, a tet and a coarse-row dispatch.
     groups: (u32, u32, u32),
     inv_h2: f32,
+    /// The mesh's mean rest edge, m (the step stop's unit).
+    mean_edge: f32,
     node_count: usize,
     /// The last step's cost.
     pub last: NewtonReport,
@@ -288,6 +290,7 @@ impl GpuNewton {
             coarse,
             scratch,
             inv_h2,
+            mean_edge: mesh.mean_edge_length(),
             node_count: n,
             last: NewtonReport::default(),
             dispatches: 0,

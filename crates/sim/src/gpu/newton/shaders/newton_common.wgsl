@@ -49,7 +49,8 @@ fn at_grad2() -> u32 { return NW.tet_groups + NW.node_groups; }
 fn at_rz() -> u32 { return NW.tet_groups + 2u * NW.node_groups; }
 fn at_pap() -> u32 { return NW.tet_groups + 3u * NW.node_groups; }
 fn at_slope() -> u32 { return NW.tet_groups + 4u * NW.node_groups; }
-fn at_state() -> u32 { return NW.tet_groups + 5u * NW.node_groups; }
+fn at_reach() -> u32 { return NW.tet_groups + 5u * NW.node_groups; }
+fn at_state() -> u32 { return NW.tet_groups + 6u * NW.node_groups; }
 const S_STOP: u32 = 0u;     // 1: the solve stopped (tolerance, product budget, rz <= 0)
 const S_NEG: u32 = 1u;      // 1: it met non-positive curvature
 const S_PRODUCTS: u32 = 2u; // products spent
@@ -77,6 +78,21 @@ fn sum64(l: u32, v: f32) -> f32 {
     let total = red[0];
     workgroupBarrier();
     return total;
+}
+
+// Largest v over a 64-thread workgroup (thread l); every thread gets it.
+fn max64(l: u32, v: f32) -> f32 {
+    red[l] = v;
+    workgroupBarrier();
+    for (var s = 32u; s > 0u; s = s >> 1u) {
+        if (l < s) {
+            red[l] = max(red[l], red[l + s]);
+        }
+        workgroupBarrier();
+    }
+    let top = red[0];
+    workgroupBarrier();
+    return top;
 }
 
 // The sum of `count` partial sums from `at`, by a 64-thread workgroup; every thread gets

@@ -95,20 +95,27 @@ fn inertia(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocat
     }
 }
 
-// The line search's trial point u + alpha d, and partial sums of the slope grad G . d.
+// The line search's trial point u + alpha d, partial sums of the slope grad G . d, and
+// per workgroup the largest |d|^2 of a free node (the step stop's reach).
 @compute @workgroup_size(64)
 fn trial(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) l: u32, @builtin(workgroup_id) wg: vec3<u32>) {
     let i = gid.x;
     var slope = 0.0;
+    var reach2 = 0.0;
     if (i < NW.node_count) {
         let d = vecs[vi(V_X, i)].xyz;
         let p = pos[i];
         vecs[vi(V_TRIAL, i)] = vec4<f32>(p.xyz + NW.alpha * d, p.w);
         slope = dot(vecs[vi(V_G, i)].xyz, d);
+        if (is_free(i)) {
+            reach2 = dot(d, d);
+        }
     }
     let total = sum64(l, slope);
+    let top = max64(l, reach2);
     if (l == 0u) {
         scratch[at_slope() + wg.x] = total;
+        scratch[at_reach() + wg.x] = top;
     }
 }
 
