@@ -20,7 +20,7 @@ use serde_json::Value;
 const SCENE: &str = "config/intestine_pull.ron";
 
 /// Seconds simulated in each mode: past the first release (frame 51 of 60 Hz) and well
-/// into the tear (1,309 tets by frame 89 in `incise run`, on the scene's implicit scheme).
+/// into the tear (1,268 tets by frame 89 in `incise run`, on the scene's implicit scheme).
 const SECONDS: f64 = 1.5;
 
 /// The number before `word` in `line` ("… 987 tets released").
