@@ -352,8 +352,9 @@ pub enum BenchTarget {
     Solver,
     /// The renderer alone, offscreen.
     Render,
-    /// The default scene at its own substeps: ms per frame split into substeps, release
-    /// checks and stress; frames per second (`--scene` for another scene).
+    /// The default scene on its own scheme: ms per frame split into the solve (XPBD
+    /// substeps or implicit steps), release checks and stress; frames per second
+    /// (`--scene` for another scene; `--markdown`: XPBD's kernels beside the implicit scheme).
     Realtime,
     /// The `--scene` of any method through its body's script: ms per frame, nodes and
     /// tets, and a Nakao body's localisation levels and loop split (`--frames` frames).

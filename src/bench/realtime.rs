@@ -1,9 +1,10 @@
-//! `incise bench realtime`: the default scene (config/intestine_pull.ron) at its own
-//! substeps, as a trainee would run it — per-frame wall ms (median, p99) split into the
-//! substeps, the release checks inside them, and the end-of-frame stress, guards and
-//! release; frames per second; on the CPU or the GPU (issue 17, item 6). Per kernel also
-//! what a sweep costs against its arithmetic (issue 35, item 5): ms per sweep on one
-//! thread and on all, their ratio, GFLOP/s from the counted flops of a projection
+//! `incise bench realtime`: the default scene (config/intestine_pull.ron) on its own
+//! scheme (the implicit scheme; XPBD's substeps for an XPBD scene), as a trainee would run
+//! it — per-frame wall ms (median, p99) split into the solve (substeps or implicit steps),
+//! the release checks inside them, and the end-of-frame stress, guards and release; frames
+//! per second; on the CPU or the GPU (issue 17, item 6). Per kernel also what a sweep
+//! costs against its arithmetic (issue 35, item 5): ms per sweep on one thread and on all,
+//! their ratio, GFLOP/s from the counted flops of a projection
 //! ([`incise_sim::xpbd::projection_flops`]) against the machine's peak
 //! ([`crate::bench::peak`]), and the parallel passes (GPU: dispatches) of a frame.
 

@@ -651,6 +651,17 @@ mod tests {
         assert!(b.set_substeps(3).is_err());
     }
 
+    /// How far `a`'s furthest node moved from rest, and how far apart `a` and `b` are at
+    /// their furthest node, m.
+    fn moved_and_apart(a: &Solver, b: &Solver) -> (f32, f32) {
+        let largest = |d: &mut dyn Iterator<Item = f32>| d.fold(0.0f32, f32::max);
+        let rest = &a.mesh().rest_positions;
+        let (x, y) = (a.positions(), b.positions());
+        let moved = largest(&mut x.iter().zip(rest).map(|(p, r)| (*p - *r).length()));
+        let apart = largest(&mut x.iter().zip(y).map(|(p, q)| (*p - *q).length()));
+        (moved, apart)
+    }
+
     /// A setting changed during a pull (the preview's slider): the body goes on from
     /// where the grab had taken the tissue, as the same frames would without the change,
     /// neither restarting the grab's path nor dropping it.
@@ -678,22 +689,7 @@ mod tests {
                 b.step(&ToolInput::Script).unwrap();
             }
         }
-        let (a, b) = (same.body.solver(), tuned.body.solver());
-        let largest = |d: &mut dyn Iterator<Item = f32>| d.fold(0.0f32, f32::max);
-        let moved = largest(
-            &mut a
-                .positions()
-                .iter()
-                .zip(&a.mesh().rest_positions)
-                .map(|(p, r)| (*p - *r).length()),
-        );
-        let apart = largest(
-            &mut a
-                .positions()
-                .iter()
-                .zip(b.positions())
-                .map(|(p, q)| (*p - *q).length()),
-        );
+        let (moved, apart) = moved_and_apart(same.body.solver(), tuned.body.solver());
         assert!(moved > 1e-3, "the grab pulls the plate: {moved} m");
         assert!(
             apart < 0.01 * moved,
@@ -736,24 +732,7 @@ mod tests {
         );
         run(&mut xpbd, 20);
         run(&mut switched, 20);
-        let (a, b) = (xpbd.body.solver(), switched.body.solver());
-        let largest = |d: &mut dyn Iterator<Item = f32>| d.fold(0.0f32, f32::max);
-        let rest = &a.mesh().rest_positions;
-        let moved = largest(
-            &mut a
-                .positions()
-                .iter()
-                .zip(rest)
-                .map(|(p, r)| (*p - *r).length()),
-        );
-        let apart = largest(
-            &mut a
-                .positions()
-                .iter()
-                .zip(b.positions())
-                .map(|(p, q)| (*p - *q).length()),
-        );
-        eprintln!("moved {moved} m, apart {apart} m");
+        let (moved, apart) = moved_and_apart(xpbd.body.solver(), switched.body.solver());
         assert!(moved > 1e-3, "the grab pulls the plate: {moved} m");
         assert!(
             apart < 0.05 * moved,

@@ -42,6 +42,28 @@ const WHOLE: f32 = 1e-3;
 /// (lavapipe: within 1 % on both bodies).
 const PRODUCTS: f64 = 0.2;
 
+/// A 10 × 2 × 2 cm beam of soft tissue (E = 100 kPa) pinned at x = 0, at rest, about to
+/// fall under gravity, on the implicit scheme with `newton`.
+fn falling_beam(newton: NewtonParams) -> Solver {
+    let mesh = common::block_mesh(
+        Vec3::new(0.0, -0.01, -0.01),
+        Vec3::new(0.1, 0.02, 0.02),
+        UVec3::new(10, 2, 2),
+    );
+    let params = SolverParams {
+        scheme: Scheme::Newton(newton),
+        damping: 5.0,
+        threads: 1,
+        ..SolverParams::default()
+    };
+    let mut s = Solver::new(mesh, common::soft(1e5, 0.45), params).unwrap();
+    let root: Vec<u32> = (0..s.mesh().node_count() as u32)
+        .filter(|&i| s.mesh().rest_positions[i as usize].x < 1e-4)
+        .collect();
+    s.pin(&root);
+    s
+}
+
 /// A 10 × 2 × 2 cm cantilever of soft tissue (E = 100 kPa) pinned at x = 0, falling
 /// under gravity and swinging to a sag of 12 % of its length: the CPU and the device end
 /// every frame within [`WHOLE`] of the tip's sag of each other, with about the same work.
@@ -50,25 +72,7 @@ fn a_bending_cantilever_matches_the_cpu() {
     let Some(ctx) = common::gpu_context() else {
         return;
     };
-    let beam = || {
-        let mesh = common::block_mesh(
-            Vec3::new(0.0, -0.01, -0.01),
-            Vec3::new(0.1, 0.02, 0.02),
-            UVec3::new(10, 2, 2),
-        );
-        let params = SolverParams {
-            scheme: Scheme::Newton(CONVERGED),
-            damping: 5.0,
-            threads: 1,
-            ..SolverParams::default()
-        };
-        let mut s = Solver::new(mesh, common::soft(1e5, 0.45), params).unwrap();
-        let root: Vec<u32> = (0..s.mesh().node_count() as u32)
-            .filter(|&i| s.mesh().rest_positions[i as usize].x < 1e-4)
-            .collect();
-        s.pin(&root);
-        s
-    };
+    let beam = || falling_beam(CONVERGED);
     let mut cpu = beam();
     let mut gpu = GpuSolver::new(beam(), &ctx).expect("upload");
     let (mut cpu_products, mut gpu_products) = (0u64, 0u64);
@@ -106,28 +110,12 @@ fn the_step_stop_ends_newton_as_on_the_cpu() {
         return;
     };
     let beam = || {
-        let mesh = common::block_mesh(
-            Vec3::new(0.0, -0.01, -0.01),
-            Vec3::new(0.1, 0.02, 0.02),
-            UVec3::new(10, 2, 2),
-        );
-        let params = SolverParams {
-            scheme: Scheme::Newton(NewtonParams {
-                iterations: 8,
-                gradient_tolerance: 1e-6,
-                step_tolerance: 0.01,
-                ..CONVERGED
-            }),
-            damping: 5.0,
-            threads: 1,
-            ..SolverParams::default()
-        };
-        let mut s = Solver::new(mesh, common::soft(1e5, 0.45), params).unwrap();
-        let root: Vec<u32> = (0..s.mesh().node_count() as u32)
-            .filter(|&i| s.mesh().rest_positions[i as usize].x < 1e-4)
-            .collect();
-        s.pin(&root);
-        s
+        falling_beam(NewtonParams {
+            iterations: 8,
+            gradient_tolerance: 1e-6,
+            step_tolerance: 0.01,
+            ..CONVERGED
+        })
     };
     let mut cpu = beam();
     let mut gpu = GpuSolver::new(beam(), &ctx).expect("upload");
