@@ -230,9 +230,9 @@ impl NewtonWorkspace {
 
     /// Backtrack along the direction from `u` until `G` decreases enough; on success `u`
     /// moves there and the tet evaluations are the new point's, else `u` stays and they
-    /// are `u`'s again. Returns the new `G` and the step's length along the direction. The
-    /// full step is evaluated in full (it is
-    /// usually taken); a halved one only for its energy, and in full once taken.
+    /// are `u`'s again. Returns the new `G` and the step's length along the direction
+    /// (`α`). The full step is evaluated in full (it is usually taken); a halved one only
+    /// for its energy, and in full once taken.
     #[allow(clippy::too_many_arguments)]
     fn line_search(
         &mut self,

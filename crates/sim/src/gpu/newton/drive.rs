@@ -184,8 +184,8 @@ impl GpuNewton {
     /// Backtrack along the direction from the iterate until `G` decreases enough (as
     /// `NewtonWorkspace::line_search`): the full step is evaluated in full, a halved one
     /// for its energy only and in full once taken. Returns the sums at the point taken and
-    /// how far the step moved the furthest free node, or `None` (the iterate stays) when the direction does not descend or no halving
-    /// decreased `G`.
+    /// how far the step moved the furthest free node, or `None` (the iterate stays) when
+    /// the direction does not descend or no halving decreased `G`.
     fn line_search(
         &mut self,
         dev: &OnDevice<'_>,
