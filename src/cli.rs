@@ -559,6 +559,7 @@ impl From<XrArgs> for XrOptions {
             sim: a.sim,
             slow_sim_ms: a.slow_sim_ms,
             inject_sim_panic_at: a.inject_sim_panic_at,
+            scheme: None,
         }
     }
 }

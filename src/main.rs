@@ -9,6 +9,7 @@ use incise::pictures::render_command;
 use incise::preview;
 use incise::run::run_scene;
 use incise::scene::built_in;
+use incise::sim_body::DeviceChoice;
 use incise::{compare, exercise, experiment, mesh_cmd};
 
 fn main() -> ExitCode {
@@ -80,7 +81,12 @@ fn main() -> ExitCode {
             ),
             frames,
             bench::BenchOutput::of(json, markdown),
-        ),
+        )
+        .map(|()| {
+            if markdown && device != DeviceChoice::Gpu {
+                incise::xr::headset_bench::print(&scene);
+            }
+        }),
         Command::Bench {
             target: BenchTarget::Scene,
             json,

@@ -348,6 +348,29 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
         assert!((scaling - one / all).abs() < 0.01 + 0.01 * scaling, "{row}");
         assert!(cells[10].parse::<f64>().unwrap() > 0.0, "GFLOP/s: {row}");
     }
+    // The headset table (issue 31, item 3): the scene on its own scheme, then on the
+    // other, in a simulated headset on the wall clock, where a renderer for its eyes exists.
+    let rows: Vec<Vec<&str>> = out
+        .lines()
+        .skip_while(|l| !l.starts_with("Headset: "))
+        .filter(|l| l.starts_with("| XPBD") || l.starts_with("| Newton"))
+        .map(|l| l.split('|').map(str::trim).collect())
+        .collect();
+    if incise_xr::RenderDevice::headless().is_ok() {
+        assert_eq!(rows.len(), 2, "{out}");
+        assert_eq!(
+            (rows[0][1], rows[1][1]),
+            ("XPBD, 24 substeps", "Newton"),
+            "{out}"
+        );
+        let low = |cell: &str| -> f64 { cell.split_once('–').unwrap().0.parse().unwrap() };
+        for r in &rows {
+            assert!(low(r[2]) > 0.0, "simulation frames a second: {out}");
+            assert!(low(r[3]) > 0.0 && low(r[4]) >= low(r[3]), "latency: {out}");
+        }
+    } else {
+        assert!(out.contains("Headset: not measured: "), "{out}");
+    }
     assert!(
         out.contains("Flops of a sweep: ") && out.contains(" per tet projection"),
         "{out}"

@@ -66,6 +66,7 @@ fn open_options(opts: &RunOptions) -> Result<OpenOptions> {
         script_until_taken: false,
         gpu: None,
         free_nodes,
+        scheme: None,
     })
 }
 

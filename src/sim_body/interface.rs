@@ -95,6 +95,9 @@ pub struct OpenOptions {
     /// choices, so that a budgeted scene replays bit for bit (docs/reliability.md, Soak;
     /// the frame-by-frame body: a `haptic_rate` thread chooses its own).
     pub free_nodes: Option<Vec<usize>>,
+    /// Run an XPBD-method scene on this time integrator instead of its `solver.scheme`
+    /// (the benchmark's headset rows); `None`: the scene's own.
+    pub scheme: Option<incise_sim::implicit::Scheme>,
     /// Print no notices.
     pub quiet: bool,
     /// A hand holds the tool from the start (the headset's controller): an XPBD scene's

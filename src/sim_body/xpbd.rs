@@ -92,6 +92,16 @@ pub fn open(
         true => ToolDriver::Hand,
         false => ToolDriver::Scene,
     };
+    let rescheduled;
+    let scene = match opts.scheme {
+        Some(scheme) => {
+            let mut s = scene.clone();
+            s.solver.scheme = scheme;
+            rescheduled = s;
+            &rescheduled
+        }
+        None => scene,
+    };
     let mut built = build_scene_driven(scene, path, opts.threads, driver)?;
     if let Some(t) = built.tool.as_mut() {
         match &opts.stroke {

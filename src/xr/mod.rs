@@ -7,6 +7,7 @@
 pub mod command;
 pub mod exercise;
 pub mod frame_loop;
+pub mod headset_bench;
 pub mod headset_sim;
 pub mod latest;
 pub mod live_sim;
@@ -72,6 +73,9 @@ pub struct XrOptions {
     pub slow_sim_ms: u64,
     /// Testing aid: a panic in the simulation just before this simulation frame.
     pub inject_sim_panic_at: Option<u64>,
+    /// Run the scene on this time integrator instead of its own (an XPBD-method scene;
+    /// `incise bench realtime`'s headset table).
+    pub scheme: Option<incise_sim::implicit::Scheme>,
 }
 
 /// Run `incise xr`; the session's summary line. No usable runtime: an [`XrUnavailable`]
@@ -173,6 +177,7 @@ fn open_body(
             gpu,
             stroke: opts.stroke.clone(),
             hand: played.is_none(),
+            scheme: opts.scheme,
             quiet: true,
             ..OpenOptions::default()
         },
