@@ -12,7 +12,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use incise_sim::implicit::{NewtonParams, Scheme};
+use incise_sim::implicit::Scheme;
 use incise_sim::xpbd::{CpuKernel, CpuSweep, NODE_FLOPS_PER_SUBSTEP, projection_flops};
 use serde::Serialize;
 
@@ -248,10 +248,8 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
 /// The implicit scheme the table compares: the scene's own Newton settings, or the
 /// defaults for an XPBD scene.
 fn newton_of(scene: &Path) -> Result<Scheme> {
-    Ok(match crate::scene::load_scene(scene)?.solver.scheme {
-        Scheme::Xpbd => Scheme::Newton(NewtonParams::default()),
-        own => own,
-    })
+    let own = crate::scene::load_scene(scene)?.solver.scheme;
+    Ok(Scheme::Newton(own.newton_or_default()))
 }
 
 /// The measurement behind [`run`], with the scene's own scheme.

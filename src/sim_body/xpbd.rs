@@ -9,7 +9,7 @@ use anyhow::{Result, bail};
 use glam::{Quat, Vec3};
 use incise_sim::contact::{CutZone, ToolPose};
 use incise_sim::gpu::GpuContext;
-use incise_sim::implicit::{NewtonParams, Scheme};
+use incise_sim::implicit::Scheme;
 use incise_sim::io::{VtuFrame, write_vtu};
 use incise_sim::skin::Skin;
 use incise_sim::xpbd::SolverError;
@@ -92,13 +92,13 @@ pub fn open(
         true => ToolDriver::Hand,
         false => ToolDriver::Scene,
     };
-    let rescheduled;
+    let on_scheme;
     let scene = match opts.scheme {
         Some(scheme) => {
             let mut s = scene.clone();
             s.solver.scheme = scheme;
-            rescheduled = s;
-            &rescheduled
+            on_scheme = s;
+            &on_scheme
         }
         None => scene,
     };
@@ -492,10 +492,7 @@ impl SimBody for XpbdBody {
             },
             substeps: p.substeps,
             implicit: p.scheme != Scheme::Xpbd,
-            newton: match p.scheme {
-                Scheme::Newton(n) => n,
-                Scheme::Xpbd => NewtonParams::default(),
-            },
+            newton: p.scheme.newton_or_default(),
             poisson_range: p.poisson_range(),
         })
     }

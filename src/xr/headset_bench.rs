@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use incise_sim::implicit::{NewtonParams, Scheme};
+use incise_sim::implicit::Scheme;
 
 use super::XrOptions;
 use super::sim_mode::SimChoice;
@@ -69,21 +69,23 @@ pub fn run(scene: &Path, scheme: Option<Scheme>, seconds: f64, dir: &Path) -> Re
         .as_f64()
         .zip(latency[1].as_f64())
         .context("the simulated headset showed no frame with a tool command")?;
+    let sim_fps = report["sim_steps_per_s"]
+        .as_f64()
+        .context("the simulated headset's report has no simulation rate")?;
     Ok(HeadsetRun {
-        sim_fps: report["sim_steps_per_s"].as_f64().unwrap_or(0.0),
+        sim_fps,
         latency_ms: (p50, p95),
     })
 }
 
-/// The schemes the headset table compares on `scene`: its own first, then the other one
-/// (XPBD at its substeps, or the implicit scheme with the scene's settings or the
+/// The schemes the headset table compares on a scene whose scheme is `own`: its own
+/// first, then the other one (XPBD at its substeps, or the implicit scheme with the
 /// defaults).
-fn schemes(scene: &Path) -> Result<[Scheme; 2]> {
-    let own = crate::scene::load_scene(scene)?.solver.scheme;
-    Ok(match own {
-        Scheme::Xpbd => [own, Scheme::Newton(NewtonParams::default())],
+fn schemes(own: Scheme) -> [Scheme; 2] {
+    match own {
+        Scheme::Xpbd => [own, Scheme::Newton(own.newton_or_default())],
         Scheme::Newton(_) => [own, Scheme::Xpbd],
-    })
+    }
 }
 
 /// `scene` on both schemes in the simulated headset, `runs` interleaved runs each, as the
@@ -92,7 +94,7 @@ pub fn markdown(scene: &Path, runs: usize) -> Result<String> {
     let loaded = crate::scene::load_scene(scene)?;
     let seconds = loaded.duration as f64;
     let substeps = loaded.solver.substeps;
-    let schemes = schemes(scene)?;
+    let schemes = schemes(loaded.solver.scheme);
     let dir = std::env::temp_dir().join(format!("incise-bench-headset-{}", std::process::id()));
     let mut got: [Vec<HeadsetRun>; 2] = [Vec::new(), Vec::new()];
     for r in 0..runs {

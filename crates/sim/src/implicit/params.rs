@@ -21,6 +21,15 @@ impl Scheme {
             Scheme::Newton(_) => "Newton",
         }
     }
+
+    /// The implicit scheme's settings: this scheme's own, or the defaults under XPBD (what
+    /// a switch to the implicit scheme starts from).
+    pub fn newton_or_default(&self) -> NewtonParams {
+        match self {
+            Scheme::Newton(p) => *p,
+            Scheme::Xpbd => NewtonParams::default(),
+        }
+    }
 }
 
 /// Settings of the implicit scheme.
