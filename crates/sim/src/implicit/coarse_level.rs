@@ -25,12 +25,11 @@ pub struct CoarseLevel {
     pub grid: CoarseGrid,
     /// `A_c`, factorised.
     pub system: CoarseSystem,
-    /// The tets' corner pairs for re-assembling `system` (`None` under
-    /// [`CoarseRefresh::Rest`]).
-    assembly: Option<CoarseAssembly>,
+    /// The tets' corner pairs for re-assembling `system`.
+    assembly: CoarseAssembly,
     policy: CoarseRefresh,
-    lame: Lame,
-    /// The tangents of the last refresh, per tet (what a release subtracts).
+    /// The tangents of the last refresh (the rest tangent before any), per tet: what a
+    /// release subtracts.
     used: Vec<TetTangent>,
     /// Per tet, whether the matrix holds its blocks at `used` (live at the last refresh
     /// and not released since).
@@ -69,16 +68,15 @@ impl CoarseLevel {
         let all = vec![true; tets.len()];
         let grid = CoarseGrid::new(&mesh.rest_positions, free, cell, (tets, &all));
         let inv_h2 = 1.0 / (h * h);
-        let system = CoarseSystem::new(&grid, tets, mass, inv_h2, lame)?;
-        let assembly = (params.coarse_refresh != CoarseRefresh::Rest)
-            .then(|| CoarseAssembly::new(&grid, tets, b, system.block_index()));
+        let rest = TetTangent::at_rest(lame).definite();
+        let (system, assembly) =
+            CoarseSystem::at_rest(&grid, (tets, b), (mass, inv_h2), &rest, true)?;
         Ok(CoarseLevel {
             system,
             assembly,
             policy: params.coarse_refresh,
-            lame,
-            used: Vec::new(),
-            in_coarse: Vec::new(),
+            used: vec![rest; tets.len()],
+            in_coarse: all,
             since_refresh: 0,
             rebuild_inputs: (params.coarse_refresh != CoarseRefresh::Rest).then(|| {
                 Arc::new(RebuildInputs {
@@ -117,9 +115,6 @@ impl CoarseLevel {
     /// Whether the coming step re-assembles the matrix ([`CoarseRefresh`]; `last`: the
     /// previous step's report).
     pub fn refresh_due(&self, last: &NewtonReport) -> bool {
-        if self.assembly.is_none() {
-            return false;
-        }
         match self.policy {
             CoarseRefresh::Rest => false,
             CoarseRefresh::Steps(n) => self.since_refresh >= n,
@@ -151,12 +146,9 @@ impl CoarseLevel {
         self.in_coarse.clear();
         self.in_coarse.extend_from_slice(live);
         self.since_refresh = 0;
-        let Some(assembly) = self.assembly.as_mut() else {
-            return Ok(());
-        };
         let used = &self.used;
         let tangent = |t: usize| live[t].then(|| &used[t]);
-        let refreshed = self.system.refresh(assembly, tangent, parallel);
+        let refreshed = self.system.refresh(&mut self.assembly, tangent, parallel);
         rebuilt.and(refreshed)
     }
 
@@ -169,7 +161,7 @@ impl CoarseLevel {
         if let Some(rebuilt) = pending.take()? {
             self.grid = rebuilt.grid;
             self.system = rebuilt.system;
-            self.assembly = Some(rebuilt.assembly);
+            self.assembly = rebuilt.assembly;
             self.generation += 1;
         }
         Ok(())
@@ -190,22 +182,18 @@ impl CoarseLevel {
         ));
     }
 
-    /// Take released tets (mesh indices; `rest`: every tet) out of the matrix: their rest
-    /// stiffness before any refresh, else their blocks at the last refresh's tangents —
-    /// only those it holds (a tet released by a check earlier in the frame may have been
-    /// left out of a refresh since).
-    pub fn release(&mut self, tets: &[u32], rest: &[RestTet]) -> Result<(), CoarseError> {
+    /// Take released tets (mesh indices) out of the matrix: their blocks at the tangents
+    /// of the last refresh (the rest tangent before any) — only those it holds (a tet
+    /// released by a check earlier in the frame may have been left out of a refresh since).
+    pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
         self.cut |= !tets.is_empty();
-        if let (Some(assembly), false) = (&self.assembly, self.used.is_empty()) {
-            let in_coarse = &mut self.in_coarse;
-            let held: Vec<u32> = tets
-                .iter()
-                .copied()
-                .filter(|&t| std::mem::take(&mut in_coarse[t as usize]))
-                .collect();
-            return self.system.release_refreshed(assembly, &held, &self.used);
-        }
-        let gone: Vec<RestTet> = tets.iter().map(|&t| rest[t as usize]).collect();
-        self.system.release(&self.grid, &gone, self.lame)
+        let in_coarse = &mut self.in_coarse;
+        let held: Vec<u32> = tets
+            .iter()
+            .copied()
+            .filter(|&t| std::mem::take(&mut in_coarse[t as usize]))
+            .collect();
+        self.system
+            .release_refreshed(&self.assembly, &held, &self.used)
     }
 }

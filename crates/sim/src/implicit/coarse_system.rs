@@ -21,8 +21,6 @@ use super::coarse_assembly::CoarseAssembly;
 use super::coarse_grid::CoarseGrid;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
-use crate::material::Lame;
-use crate::vbd::shape_gradients;
 
 /// Why the coarse factorisation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -58,22 +56,22 @@ pub struct CoarseSystem {
 }
 
 impl CoarseSystem {
-    /// `Pᵀ (M/h² + K) P` over `tets` (live ones) and the nodes' `mass`, factorised.
-    pub fn new(
+    /// `Pᵀ (M/h² + K_rest) P` over `tets` (shape gradients `b`, every one live) and the
+    /// nodes' `mass`, factorised, with the assembly that refreshes it: the pattern of
+    /// [`CoarseSystem::mass_only`] filled as a refresh at the tangent `rest` (at rest,
+    /// linear elasticity), so the tets are summed by corner group in SIMD lanes, not pair
+    /// by pair.
+    pub fn at_rest(
         grid: &CoarseGrid,
-        tets: &[RestTet],
-        mass: &[f32],
-        inv_h2: f32,
-        lame: Lame,
-    ) -> Result<Self, CoarseError> {
-        let mut index = HashMap::new();
-        let mut blocks = Vec::new();
-        for t in tets {
-            tet_contribution(grid, t, lame, &mut |v, w, b| {
-                add_block(&mut index, &mut blocks, (v, w), &b);
-            });
-        }
-        Self::with_mass(grid, (index, blocks), mass, inv_h2)
+        (tets, b): (&[RestTet], &[[Vec3; 4]]),
+        (mass, inv_h2): (&[f32], f32),
+        rest: &TetTangent,
+        parallel: bool,
+    ) -> Result<(Self, CoarseAssembly), CoarseError> {
+        let mut system = Self::mass_only(grid, tets, mass, inv_h2)?;
+        let mut assembly = CoarseAssembly::new(grid, tets, b, &system.index);
+        system.refresh(&mut assembly, |_| Some(rest), parallel)?;
+        Ok((system, assembly))
     }
 
     /// `Pᵀ (M/h²) P` on the pattern of every pair of coarse nodes a tet of `tets`
@@ -144,23 +142,6 @@ impl CoarseSystem {
             symbolic,
             factor,
         })
-    }
-
-    /// Subtract released tets' stiffness and refactorise on the same pattern.
-    pub fn release(
-        &mut self,
-        grid: &CoarseGrid,
-        tets: &[RestTet],
-        lame: Lame,
-    ) -> Result<(), CoarseError> {
-        for t in tets {
-            tet_contribution(grid, t, lame, &mut |v, w, b| {
-                if let Some(&k) = self.index.get(&(v, w)) {
-                    accumulate(&mut self.blocks[k], &b, -1.0);
-                }
-            });
-        }
-        self.refactor()
     }
 
     /// Re-assemble the matrix from the mass and the tets' current tangents (`tangent(t)`
@@ -288,51 +269,6 @@ fn accumulate(b: &mut [f64; 9], m: &Mat3, scale: f64) {
     }
 }
 
-/// The small-strain stiffness block `∂²E/∂x_a∂x_b` of a tet with shape gradients `b`:
-/// `V [μ (b_a·b_b) I + μ b_b b_aᵀ + λ b_a b_bᵀ]` (linear elasticity, the tangent of
-/// [`super::TetTangent`] at rest).
-fn rest_block(b: &[Vec3; 4], a: usize, c: usize, volume: f32, lame: Lame) -> Mat3 {
-    let outer = |x: Vec3, y: Vec3| Mat3::from_cols(x * y.x, x * y.y, x * y.z);
-    (Mat3::IDENTITY * (lame.mu * b[a].dot(b[c]))
-        + outer(b[c], b[a]) * lame.mu
-        + outer(b[a], b[c]) * lame.lambda)
-        * volume
-}
-
-/// Call `out(v, w, block)` for the lower-triangle coarse blocks (v ≥ w) of `Pᵀ K_t P`.
-fn tet_contribution(
-    grid: &CoarseGrid,
-    t: &RestTet,
-    lame: Lame,
-    out: &mut impl FnMut(u32, u32, Mat3),
-) {
-    let b = shape_gradients(&t.dm_inv);
-    let mut local: Vec<(u32, u32, Mat3)> = Vec::with_capacity(256);
-    for a in 0..4 {
-        for c in 0..4 {
-            let k = rest_block(&b, a, c, t.volume, lame);
-            for &(v, wa) in &grid.weights[t.nodes[a] as usize] {
-                for &(w, wc) in &grid.weights[t.nodes[c] as usize] {
-                    if v >= w && wa * wc != 0.0 {
-                        merge(&mut local, v, w, k * (wa * wc));
-                    }
-                }
-            }
-        }
-    }
-    for (v, w, m) in local {
-        out(v, w, m);
-    }
-}
-
-/// Add `m` to the entry `(v, w)` of a short list.
-fn merge(local: &mut Vec<(u32, u32, Mat3)>, v: u32, w: u32, m: Mat3) {
-    match local.iter_mut().find(|(a, b, _)| *a == v && *b == w) {
-        Some(e) => e.2 += m,
-        None => local.push((v, w, m)),
-    }
-}
-
 /// Call `out(v, w, block)` for a node's mass term `Pᵀ (m/h² I) P` (lower triangle).
 fn node_mass(weights: &[(u32, f32); 8], m: f32, out: &mut impl FnMut(u32, u32, Mat3)) {
     for &(v, wv) in weights {
@@ -379,6 +315,8 @@ fn pattern(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::material::Lame;
+    use crate::vbd::shape_gradients;
 
     fn lame() -> Lame {
         Lame {
@@ -387,12 +325,25 @@ mod tests {
         }
     }
 
+    /// The small-strain stiffness block `∂²E/∂x_a∂x_b` of a tet with shape gradients `b`:
+    /// `V [μ (b_a·b_b) I + μ b_b b_aᵀ + λ b_a b_bᵀ]` (linear elasticity).
+    fn rest_block(b: &[Vec3; 4], a: usize, c: usize, volume: f32, lame: Lame) -> Mat3 {
+        let outer = |x: Vec3, y: Vec3| Mat3::from_cols(x * y.x, x * y.y, x * y.z);
+        (Mat3::IDENTITY * (lame.mu * b[a].dot(b[c]))
+            + outer(b[c], b[a]) * lame.mu
+            + outer(b[a], b[c]) * lame.lambda)
+            * volume
+    }
+
     /// The coarse matrix of a block of tets against `Pᵀ A P` formed densely.
     #[test]
     fn the_coarse_matrix_is_the_galerkin_product_and_factorises() {
         let (mesh, grid, tets) = crate::implicit::coarse_grid::test_block();
         let mass = mesh.lumped_masses(1040.0);
-        let sys = CoarseSystem::new(&grid, &tets, &mass, 3600.0, lame()).unwrap();
+        let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
+        let rest = TetTangent::at_rest(lame());
+        let (sys, _) =
+            CoarseSystem::at_rest(&grid, (&tets, &b), (&mass, 3600.0), &rest, true).unwrap();
         let nc = 3 * grid.count;
         // Dense Pᵀ A P.
         let mut dense = vec![0.0f64; nc * nc];

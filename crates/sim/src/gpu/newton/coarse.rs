@@ -116,6 +116,6 @@ impl HostCoarse {
     /// Take released tets (mesh indices) out of the coarse matrix, as
     /// `NewtonWorkspace::release` does ([`CoarseLevel::release`]).
     pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
-        self.level.release(tets, &self.tets)
+        self.level.release(tets)
     }
 }
