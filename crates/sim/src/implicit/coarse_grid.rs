@@ -83,7 +83,7 @@ impl CoarseGrid {
         if parallel {
             out.par_chunks_mut(3)
                 .enumerate()
-                .with_min_len(8)
+                .with_min_len(self.count.div_ceil(RESTRICT_TASKS).max(1))
                 .for_each(node);
         } else {
             out.chunks_mut(3).enumerate().for_each(node);
@@ -96,32 +96,19 @@ impl CoarseGrid {
         (&self.transpose_offsets, &self.transpose)
     }
 
-    /// `z += P c`: coarse values interpolated onto the fine nodes (in f32, each coarse
-    /// value rounded once).
-    pub fn prolong_add(&self, c: &[f64], z: &mut [Vec3], parallel: bool) {
-        let c: Vec<Vec3> = c
-            .chunks_exact(3)
-            .map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
-            .collect();
-        let node = |(w, z): (&NodeWeights, &mut Vec3)| {
-            for &(id, wk) in w {
-                *z += wk * c[id as usize];
-            }
-        };
-        if parallel {
-            self.weights
-                .par_iter()
-                .zip(z.par_iter_mut())
-                .with_min_len(PROLONG_CHUNK)
-                .for_each(node);
-        } else {
-            self.weights.iter().zip(z.iter_mut()).for_each(node);
-        }
+    /// `z + (P c)_i`: fine node `i`'s value `z` plus the coarse values `c` interpolated
+    /// onto it, corner by corner (what the preconditioner's node pass adds).
+    #[inline]
+    pub fn add_prolonged(&self, i: usize, c: &[Vec3], z: Vec3) -> Vec3 {
+        self.weights[i]
+            .iter()
+            .fold(z, |z, &(id, wk)| z + wk * c[id as usize])
     }
 }
 
-/// Fine nodes per rayon task of the prolongation.
-const PROLONG_CHUNK: usize = 1024;
+/// Tasks of the parallel restriction (a few per core on the machines of the issues: each
+/// task's setup costs about what a few coarse nodes' sums do).
+const RESTRICT_TASKS: usize = 4;
 
 /// `weights` (fine node → its corners) transposed: per coarse node of `count`, the range
 /// of the list of (fine node, weight) pairs with a nonzero weight, in fine-node order.
@@ -364,15 +351,17 @@ mod tests {
             .collect();
         let mut pr = vec![0.0; 3 * grid.count];
         grid.restrict(&r, &mut pr, false);
-        let mut z = vec![Vec3::ZERO; pts.len()];
-        grid.prolong_add(&c, &mut z, false);
+        let c3: Vec<Vec3> = c
+            .chunks(3)
+            .map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+            .collect();
+        let z: Vec<Vec3> = (0..pts.len())
+            .map(|i| grid.add_prolonged(i, &c3, Vec3::ZERO))
+            .collect();
         // In parallel: the same values.
         let mut pr2 = vec![1.0; 3 * grid.count];
         grid.restrict(&r, &mut pr2, true);
         assert_eq!(pr, pr2);
-        let mut z2 = vec![Vec3::ZERO; pts.len()];
-        grid.prolong_add(&c, &mut z2, true);
-        assert_eq!(z, z2);
         // (Pᵀ r)·c == r·(P c)
         let lhs: f64 = pr.iter().zip(&c).map(|(a, b)| a * b).sum();
         let rhs: f64 = r.iter().zip(&z).map(|(a, b)| a.dot(*b) as f64).sum();

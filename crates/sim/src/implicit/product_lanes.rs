@@ -88,21 +88,22 @@ pub fn tangent_lanes(n: usize, t: impl Fn(usize) -> TetTangent) -> TangentLanes 
     out
 }
 
-/// The four nodal forces `V dP[dF] b_a` of each tet of the chunk for the direction `p`
-/// (zero where `live` is false), into `out` (one entry per tet of the chunk).
-pub fn product(
+/// Add the four nodal forces `V dP[dF] b_a` of each live tet of the chunk for the
+/// direction `p` to `sums` (per node; lane by lane, corner by corner, as the scalar
+/// product adds them).
+pub fn product_add(
     rest: &RestLanes,
     tan: &TangentLanes,
     live: &[bool],
     p: &[Vec3],
-    out: &mut [[Vec3; 4]],
+    sums: &mut [Vec3],
 ) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2.
-        return unsafe { product_avx2(rest, tan, live, p, out) };
+        return unsafe { product_avx2(rest, tan, live, p, sums) };
     }
-    product_in::<wide::f32x8>(rest, tan, live, p, out);
+    product_in::<wide::f32x8>(rest, tan, live, p, sums);
 }
 
 /// [`product_in`] with AVX lanes, compiled for AVX2.
@@ -116,9 +117,9 @@ unsafe fn product_avx2(
     tan: &TangentLanes,
     live: &[bool],
     p: &[Vec3],
-    out: &mut [[Vec3; 4]],
+    sums: &mut [Vec3],
 ) {
-    product_in::<crate::xpbd::lane_avx::Avx>(rest, tan, live, p, out);
+    product_in::<crate::xpbd::lane_avx::Avx>(rest, tan, live, p, sums);
 }
 
 /// The product in lanes of type `L`, compiled into its caller (loops written out: an
@@ -129,7 +130,7 @@ fn product_in<L: Lane>(
     tan: &TangentLanes,
     live: &[bool],
     p: &[Vec3],
-    out: &mut [[Vec3; 4]],
+    sums: &mut [Vec3],
 ) {
     let mut d = [[Vec3::ZERO; LANES]; 4];
     for k in 0..rest.count {
@@ -168,11 +169,9 @@ fn product_in<L: Lane>(
         f2.to_arrays(),
         f3.to_arrays(),
     ];
-    for k in 0..rest.count {
-        out[k] = if live[k] {
-            std::array::from_fn(|a| Vec3::new(f[a][0][k], f[a][1][k], f[a][2][k]))
-        } else {
-            [Vec3::ZERO; 4]
-        };
+    for k in (0..rest.count).filter(|&k| live[k]) {
+        for a in 0..4 {
+            sums[rest.nodes[k][a] as usize] += Vec3::new(f[a][0][k], f[a][1][k], f[a][2][k]);
+        }
     }
 }

@@ -5,7 +5,7 @@
 use glam::{Mat3, Vec3};
 
 use super::eval_lanes::{self, EvalLanes};
-use super::product_lanes::{RestLanes, TangentLanes, product, rest_lanes, tangent_lanes};
+use super::product_lanes::{RestLanes, TangentLanes, product_add, rest_lanes, tangent_lanes};
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
@@ -128,34 +128,45 @@ impl TetEvals {
     }
 }
 
+/// Fixed ranges of the tets whose product forces are summed apart (each on a thread of
+/// its own when parallel) and then added in order, so the sums do not depend on the
+/// thread count.
+pub(super) const PRODUCT_PARTS: usize = 4;
+
 impl TetEvals {
-    /// Each live tet's nodal forces `V dP[dF(p)] b_a` for the direction `p = at.u` at the
-    /// last evaluation's tangents (zero for the others), into `out` (one entry per tet):
-    /// the tets' part of the Hessian product.
-    pub(super) fn products(&self, tets: &[RestTet], at: Iterate, out: &mut [[Vec3; 4]]) {
-        match self {
-            TetEvals::Lanes { rest, tangents, .. } => {
-                let run = |(c, out): (usize, &mut [[Vec3; 4]])| {
-                    let live = &at.live[c * LANES..(c * LANES + out.len())];
-                    product(&rest[c], &tangents[c], live, at.u, out);
-                };
-                if at.parallel {
-                    use rayon::prelude::*;
-                    out.par_chunks_mut(LANES)
-                        .enumerate()
-                        .with_min_len(CHUNK / LANES)
-                        .for_each(run);
-                } else {
-                    out.chunks_mut(LANES).enumerate().for_each(run);
+    /// The live tets' nodal forces `V dP[dF(p)] b_a` for the direction `p = at.u` at the
+    /// last evaluation's tangents, summed per node into `parts` ([`PRODUCT_PARTS`] node
+    /// vectors, one per fixed range of tets): the tets' part of the Hessian product.
+    pub(super) fn products(&self, tets: &[RestTet], at: Iterate, parts: &mut [Vec<Vec3>]) {
+        let chunks = tets.len().div_ceil(LANES);
+        let per = chunks.div_ceil(PRODUCT_PARTS).max(1);
+        let run = |(k, sums): (usize, &mut Vec<Vec3>)| {
+            sums.clear();
+            sums.resize(at.u.len(), Vec3::ZERO);
+            let range = (k * per).min(chunks)..((k + 1) * per).min(chunks);
+            match self {
+                TetEvals::Lanes { rest, tangents, .. } => {
+                    for c in range {
+                        let live = &at.live[c * LANES..c * LANES + rest[c].count];
+                        product_add(&rest[c], &tangents[c], live, at.u, sums);
+                    }
+                }
+                TetEvals::Scalar(evals) => {
+                    let tets_in = range.start * LANES..(range.end * LANES).min(tets.len());
+                    for t in tets_in.filter(|&t| at.live[t]) {
+                        let f = scalar_product(&tets[t], &at.b[t], &evals[t].tangent, at.u);
+                        for (&i, f) in tets[t].nodes.iter().zip(f) {
+                            sums[i as usize] += f;
+                        }
+                    }
                 }
             }
-            TetEvals::Scalar(evals) => for_each(at.parallel, out, |t, f| {
-                *f = if at.live[t] {
-                    scalar_product(&tets[t], &at.b[t], &evals[t].tangent, at.u)
-                } else {
-                    [Vec3::ZERO; 4]
-                };
-            }),
+        };
+        if at.parallel {
+            use rayon::prelude::*;
+            parts.par_iter_mut().enumerate().for_each(run);
+        } else {
+            parts.iter_mut().enumerate().for_each(run);
         }
     }
 }

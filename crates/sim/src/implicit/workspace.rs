@@ -23,7 +23,7 @@ use super::newton_report::NewtonReport;
 use super::params::{NewtonParams, Smoother};
 use super::pcg::{dot, pcg};
 use super::rest_tet::RestTet;
-use super::tet_evals::{Iterate, TetEvals, for_each};
+use super::tet_evals::{Iterate, PRODUCT_PARTS, TetEvals, for_each};
 use crate::material::Lame;
 use crate::mesh::TetMesh;
 use crate::vbd::shape_gradients;
@@ -47,7 +47,8 @@ struct Hessian {
     /// The tets' evaluations, in chunks of eight for the SIMD kernels or tet by tet
     /// (the reference).
     evals: TetEvals,
-    products: Vec<[Vec3; 4]>,
+    /// The tets' product forces summed per node, one vector per fixed range of tets.
+    product_parts: Vec<Vec<Vec3>>,
 }
 
 /// Block Jacobi plus the coarse correction.
@@ -56,7 +57,10 @@ struct TwoLevel {
     level: CoarseLevel,
     /// The assembled Hessian for the Gauss–Seidel smoother (`None`: block Jacobi).
     matrix: Option<BlockMatrix>,
+    /// The coarse right-hand side and solution (f64, three per coarse node).
     rhs: Vec<f64>,
+    /// The coarse solution in f32 (each value rounded once), what the fine nodes read.
+    coarse: Vec<Vec3>,
 }
 
 /// Buffers and the preconditioner of the implicit scheme for one body.
@@ -100,7 +104,7 @@ impl NewtonWorkspace {
             hessian: Hessian {
                 b,
                 evals,
-                products: vec![[Vec3::ZERO; 4]; tets.len()],
+                product_parts: vec![Vec::new(); PRODUCT_PARTS],
                 tets,
                 inc_offsets,
                 inc,
@@ -111,6 +115,7 @@ impl NewtonWorkspace {
             pre: TwoLevel {
                 diag_inv: vec![Mat3::ZERO; n],
                 rhs: vec![0.0; 3 * level.grid.count],
+                coarse: Vec::new(),
                 level,
                 matrix,
             },
@@ -391,21 +396,22 @@ impl Hessian {
             b: &self.b,
             parallel,
         };
-        self.evals.products(&self.tets, at, &mut self.products);
+        self.evals.products(&self.tets, at, &mut self.product_parts);
         self.gather_products(p, out, free, parallel);
     }
 
-    /// `out = M/h² p + Σ` the tets' forces at each free node (zero at fixed nodes).
+    /// `out = M/h² p +` the tets' forces at each free node, the parts added in order
+    /// (zero at fixed nodes).
     fn gather_products(&self, p: &[Vec3], out: &mut [Vec3], free: &[bool], parallel: bool) {
-        let (products, mass, inv_h2) = (&self.products, &self.mass, self.inv_h2);
+        let (parts, mass, inv_h2) = (&self.product_parts, &self.mass, self.inv_h2);
         let node = |i: usize, o: &mut Vec3| {
             if !free[i] {
                 *o = Vec3::ZERO;
                 return;
             }
             let mut sum = p[i] * (mass[i] * inv_h2);
-            for &(t, a) in self.incident(i) {
-                sum += products[t as usize][a as usize];
+            for part in parts {
+                sum += part[i];
             }
             *o = sum;
         };
@@ -421,24 +427,33 @@ impl Hessian {
 impl TwoLevel {
     /// `z = S r + P A_c⁻¹ Pᵀ r` (additive two-level; zero at fixed nodes), `S` one
     /// symmetric Gauss–Seidel sweep where the smoother is `GaussSeidel` and `smooth`, else
-    /// block Jacobi `D⁻¹`.
+    /// block Jacobi `D⁻¹`; the fine part, the prolongation and the mask in one node pass.
     fn apply(&mut self, r: &[Vec3], z: &mut [Vec3], free: &[bool], parallel: bool, smooth: bool) {
-        if let (Some(m), true) = (&self.matrix, smooth) {
-            m.symmetric_gauss_seidel(r, z, free);
-        } else {
-            for i in 0..r.len() {
-                z[i] = self.diag_inv[i] * r[i];
-            }
-        }
         let level = &self.level;
         level.grid.restrict(r, &mut self.rhs, parallel);
         level.system.solve(&mut self.rhs);
-        level.grid.prolong_add(&self.rhs, z, parallel);
-        for (z, f) in z.iter_mut().zip(free) {
-            if !f {
-                *z = Vec3::ZERO;
+        self.coarse.clear();
+        self.coarse.extend(
+            self.rhs
+                .chunks_exact(3)
+                .map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)),
+        );
+        let smoothed = match (&self.matrix, smooth) {
+            (Some(m), true) => {
+                m.symmetric_gauss_seidel(r, z, free);
+                true
             }
-        }
+            _ => false,
+        };
+        let (grid, coarse, diag_inv) = (&level.grid, &self.coarse, &self.diag_inv);
+        for_each(parallel, z, |i, z| {
+            *z = if !free[i] {
+                Vec3::ZERO
+            } else {
+                let fine = if smoothed { *z } else { diag_inv[i] * r[i] };
+                grid.add_prolonged(i, coarse, fine)
+            };
+        });
     }
 }
 
