@@ -2,7 +2,7 @@
 //! blocks, energies and stress tangents), kept tet by tet (the scalar reference) or eight
 //! tets to a chunk ([`super::eval_lanes`], what the SIMD product reads).
 
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Vec3, Vec3A};
 
 use super::eval_lanes::{self, EvalLanes};
 use super::product_lanes::{RestLanes, TangentLanes, product_add, rest_lanes, tangent_lanes};
@@ -137,12 +137,12 @@ impl TetEvals {
     /// The live tets' nodal forces `V dP[dF(p)] b_a` for the direction `p = at.u` at the
     /// last evaluation's tangents, summed per node into `parts` ([`PRODUCT_PARTS`] node
     /// vectors, one per fixed range of tets): the tets' part of the Hessian product.
-    pub(super) fn products(&self, tets: &[RestTet], at: Iterate, parts: &mut [Vec<Vec3>]) {
+    pub(super) fn products(&self, tets: &[RestTet], at: Iterate, parts: &mut [Vec<Vec3A>]) {
         let chunks = tets.len().div_ceil(LANES);
         let per = chunks.div_ceil(PRODUCT_PARTS).max(1);
-        let run = |(k, sums): (usize, &mut Vec<Vec3>)| {
+        let run = |(k, sums): (usize, &mut Vec<Vec3A>)| {
             sums.clear();
-            sums.resize(at.u.len(), Vec3::ZERO);
+            sums.resize(at.u.len(), Vec3A::ZERO);
             let range = (k * per).min(chunks)..((k + 1) * per).min(chunks);
             match self {
                 TetEvals::Lanes { rest, tangents, .. } => {
@@ -156,7 +156,7 @@ impl TetEvals {
                     for t in tets_in.filter(|&t| at.live[t]) {
                         let f = scalar_product(&tets[t], &at.b[t], &evals[t].tangent, at.u);
                         for (&i, f) in tets[t].nodes.iter().zip(f) {
-                            sums[i as usize] += f;
+                            sums[i as usize] += Vec3A::from(f);
                         }
                     }
                 }

@@ -13,7 +13,7 @@
 //! ([`BlockMatrix`]), plus a coarse-grid correction `P A_c⁻¹ Pᵀ` ([`super::CoarseLevel`]). A
 //! backtracking line search on `G` keeps every step a descent.
 
-use glam::{Mat3, Vec3};
+use glam::{Mat3, Vec3, Vec3A};
 use rayon::prelude::*;
 
 use super::block_matrix::BlockMatrix;
@@ -48,7 +48,7 @@ struct Hessian {
     /// (the reference).
     evals: TetEvals,
     /// The tets' product forces summed per node, one vector per fixed range of tets.
-    product_parts: Vec<Vec<Vec3>>,
+    product_parts: Vec<Vec<Vec3A>>,
 }
 
 /// Block Jacobi plus the coarse correction.
@@ -411,7 +411,7 @@ impl Hessian {
             }
             let mut sum = p[i] * (mass[i] * inv_h2);
             for part in parts {
-                sum += part[i];
+                sum += Vec3::from(part[i]);
             }
             *o = sum;
         };
