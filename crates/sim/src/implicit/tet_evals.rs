@@ -137,22 +137,32 @@ impl TetEvals {
     /// The live tets' nodal forces `V dP[dF(p)] b_a` for the direction `p = at.u` at the
     /// last evaluation's tangents, summed per node into `parts` ([`PRODUCT_PARTS`] node
     /// vectors, one per fixed range of tets): the tets' part of the Hessian product.
-    pub(super) fn products(&self, tets: &[RestTet], at: Iterate, parts: &mut [Vec<Vec3A>]) {
-        let chunks = tets.len().div_ceil(LANES);
-        let per = chunks.div_ceil(PRODUCT_PARTS).max(1);
+    /// Only the chunks of eight tets listed in `active` are summed (those with a free
+    /// node: the others' forces fall on fixed nodes alone), split into the parts in order.
+    pub(super) fn products(
+        &self,
+        tets: &[RestTet],
+        at: Iterate,
+        active: &[u32],
+        parts: &mut [Vec<Vec3A>],
+    ) {
+        let per = active.len().div_ceil(PRODUCT_PARTS).max(1);
         let run = |(k, sums): (usize, &mut Vec<Vec3A>)| {
             sums.clear();
             sums.resize(at.u.len(), Vec3A::ZERO);
-            let range = (k * per).min(chunks)..((k + 1) * per).min(chunks);
+            let mine = &active[(k * per).min(active.len())..((k + 1) * per).min(active.len())];
             match self {
                 TetEvals::Lanes { rest, tangents, .. } => {
-                    for c in range {
+                    for &c in mine {
+                        let c = c as usize;
                         let live = &at.live[c * LANES..c * LANES + rest[c].count];
                         product_add(&rest[c], &tangents[c], live, at.u, sums);
                     }
                 }
                 TetEvals::Scalar(evals) => {
-                    let tets_in = range.start * LANES..(range.end * LANES).min(tets.len());
+                    let tets_in = mine.iter().flat_map(|&c| {
+                        c as usize * LANES..((c as usize + 1) * LANES).min(tets.len())
+                    });
                     for t in tets_in.filter(|&t| at.live[t]) {
                         let f = scalar_product(&tets[t], &at.b[t], &evals[t].tangent, at.u);
                         for (&i, f) in tets[t].nodes.iter().zip(f) {
@@ -169,6 +179,18 @@ impl TetEvals {
             parts.iter_mut().enumerate().for_each(run);
         }
     }
+}
+
+/// The chunks of eight tets (mesh order) with a live tet that has a free node: the
+/// tets whose product forces reach a free node.
+pub(super) fn active_chunks(tets: &[RestTet], live: &[bool], free: &[bool]) -> Vec<u32> {
+    (0..tets.len().div_ceil(LANES))
+        .filter(|&c| {
+            (c * LANES..((c + 1) * LANES).min(tets.len()))
+                .any(|t| live[t] && tets[t].nodes.iter().any(|&i| free[i as usize]))
+        })
+        .map(|c| c as u32)
+        .collect()
 }
 
 /// One tet's nodal forces for the direction `p` (the reference for the lanes).

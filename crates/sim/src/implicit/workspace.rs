@@ -23,7 +23,7 @@ use super::newton_report::NewtonReport;
 use super::params::{NewtonParams, Smoother};
 use super::pcg::{dot, pcg};
 use super::rest_tet::RestTet;
-use super::tet_evals::{Iterate, PRODUCT_PARTS, TetEvals, for_each};
+use super::tet_evals::{Iterate, PRODUCT_PARTS, TetEvals, active_chunks, for_each};
 use crate::material::Lame;
 use crate::mesh::TetMesh;
 use crate::vbd::shape_gradients;
@@ -49,6 +49,8 @@ struct Hessian {
     evals: TetEvals,
     /// The tets' product forces summed per node, one vector per fixed range of tets.
     product_parts: Vec<Vec<Vec3A>>,
+    /// The chunks of eight tets whose forces reach a free node (found once a step).
+    active: Vec<u32>,
 }
 
 /// Block Jacobi plus the coarse correction.
@@ -105,6 +107,7 @@ impl NewtonWorkspace {
                 b,
                 evals,
                 product_parts: vec![Vec::new(); PRODUCT_PARTS],
+                active: Vec::new(),
                 tets,
                 inc_offsets,
                 inc,
@@ -150,6 +153,7 @@ impl NewtonWorkspace {
         parallel: bool,
     ) {
         let mut report = NewtonReport::default();
+        self.hessian.find_active(live, free);
         let mut g_now = self.hessian.evaluate(u, y, live, free, parallel);
         if self.pre.level.refresh_due(&self.last) {
             report.coarse_refreshed = true;
@@ -380,7 +384,13 @@ impl Hessian {
         }
     }
 
-    /// `out = ∇²G p` (zero at fixed nodes).
+    /// Find the chunks of tets whose forces reach a free node (what [`Hessian::apply`]
+    /// sums): once a step, as `live` and `free` change only between steps.
+    fn find_active(&mut self, live: &[bool], free: &[bool]) {
+        self.active = active_chunks(&self.tets, live, free);
+    }
+
+    /// `out = ∇²G p` (zero at fixed nodes; the chunks of [`Hessian::find_active`]).
     fn apply(
         &mut self,
         p: &[Vec3],
@@ -396,7 +406,9 @@ impl Hessian {
             b: &self.b,
             parallel,
         };
-        self.evals.products(&self.tets, at, &mut self.product_parts);
+        let active = &self.active;
+        self.evals
+            .products(&self.tets, at, active, &mut self.product_parts);
         self.gather_products(p, out, free, parallel);
     }
 
@@ -545,6 +557,7 @@ mod tests {
         let mut out = [vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]];
         for (ws, o) in [&mut scalar, &mut lanes].into_iter().zip(out.iter_mut()) {
             ws.hessian.evaluate(&u, &u, &live, &free, true);
+            ws.hessian.find_active(&live, &free);
             ws.hessian.apply(&p, o, &live, &free, true);
         }
         let scale = out[0].iter().map(|v| v.length()).fold(0.0, f32::max);
@@ -658,6 +671,7 @@ mod tests {
             let mut assembled = |u: &[Vec3], exact: bool| {
                 ws.hessian.evaluate(u, u, &live, &free, false);
                 let mut want = vec![Vec3::ZERO; n];
+                ws.hessian.find_active(&live, &free);
                 ws.hessian.apply(&p, &mut want, &live, &free, false);
                 let h = &ws.hessian;
                 let mut m = BlockMatrix::new(n, &h.tets);
@@ -679,6 +693,40 @@ mod tests {
         assert!(
             scale > 0.0 && err <= 1e-4 * scale,
             "definite, lanes against tet by tet: off by {err} of {scale}"
+        );
+    }
+
+    /// The product over the chunks with a free node is the product over every chunk: on a
+    /// block whose only free nodes are one node and the far half, so that whole chunks
+    /// have no free node and are skipped, and the lone node is each of its tets' corners
+    /// in turn.
+    #[test]
+    fn the_product_skips_only_tets_without_a_free_node() {
+        let (mesh, mut ws, _) = setup_with(true);
+        let n = mesh.node_count();
+        let lone = mesh.tets[40][2] as usize;
+        let free: Vec<bool> = (0..n)
+            .map(|i| i == lone || mesh.rest_positions[i].x > 0.0301)
+            .collect();
+        let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 7 != 2).collect();
+        let u = wobble(n, 1e-3);
+        let p = wobble(n + 5, 1.0)[5..].to_vec();
+        ws.hessian.evaluate(&u, &u, &live, &free, false);
+        let chunks = mesh.tet_count().div_ceil(LANES);
+        let mut out = [vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]];
+        ws.hessian.find_active(&live, &free);
+        let skipped = chunks - ws.hessian.active.len();
+        ws.hessian.apply(&p, &mut out[0], &live, &free, false);
+        ws.hessian.active = (0..chunks as u32).collect();
+        ws.hessian.apply(&p, &mut out[1], &live, &free, false);
+        assert!(
+            skipped > chunks / 4,
+            "only {skipped} of {chunks} chunks skipped"
+        );
+        let (err, scale) = worst(&out[1], &out[0]);
+        assert!(
+            scale > 0.0 && err <= 1e-5 * scale,
+            "the skipped chunks held a free node's forces: off by {err} of {scale}"
         );
     }
 
@@ -796,6 +844,7 @@ mod tests {
         let (gp, gm) = (grad_at(&mut ws, eps), grad_at(&mut ws, -eps));
         ws.hessian.evaluate(&u, &y, &live, &free, false);
         let mut hp = vec![Vec3::ZERO; n];
+        ws.hessian.find_active(&live, &free);
         ws.hessian.apply(&p, &mut hp, &live, &free, false);
         let fd: Vec<Vec3> = gp
             .iter()
