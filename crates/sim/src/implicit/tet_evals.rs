@@ -101,12 +101,16 @@ impl TetEvals {
         }
     }
 
-    /// Evaluate every tet at `u` (`full` false: the energies alone, the rest kept).
-    pub(super) fn evaluate(&mut self, tets: &[RestTet], at: Iterate, full: bool) {
+    /// Evaluate every tet at `u` (`full` false: the energies alone, the rest kept) but
+    /// those of the chunks of eight marked in `skip` (which keep their values).
+    pub(super) fn evaluate(&mut self, tets: &[RestTet], at: Iterate, full: bool, skip: &[bool]) {
+        let skipped = |c: usize| skip.get(c).copied().unwrap_or(false);
         match self {
             TetEvals::Scalar(evals) => {
                 for_each(at.parallel, evals, |t, out| {
-                    scalar_eval(&tets[t], &at.b[t], at, at.live[t], full, out)
+                    if !skipped(t / LANES) {
+                        scalar_eval(&tets[t], &at.b[t], at, at.live[t], full, out)
+                    }
                 });
             }
             TetEvals::Lanes {
@@ -115,6 +119,9 @@ impl TetEvals {
                 tangents,
             } => {
                 let run = |c: usize, (out, tan): (&mut EvalLanes, &mut TangentLanes)| {
+                    if skipped(c) {
+                        return;
+                    }
                     let live = &at.live[c * LANES..c * LANES + rest[c].count];
                     if full {
                         eval_lanes::evaluate(&rest[c], live, at.u, at.lame, out, tan);
