@@ -763,7 +763,7 @@ mod tests {
             .map(|(u, (d, f))| if *f { *u + *d } else { *u })
             .collect();
         let y = wobble(n + 4, 1e-3)[4..].to_vec();
-        let mut at_moved = |ws: &mut NewtonWorkspace| {
+        let at_moved = |ws: &mut NewtonWorkspace| {
             let g = ws.hessian.evaluate(&moved, &y, &live, &free, false);
             let e = ws.hessian.energy(&moved, &y, &live, &free, false);
             let (mut grad, mut d) = (vec![Vec3::ZERO; n], vec![Mat3::ZERO; n]);
