@@ -18,7 +18,7 @@
 //! `(j, k)` of every tet and the coarse block each adds to are found once: a refresh is
 //! arithmetic and sums, and a released tet only drops out of the sum.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 use std::ops::Range;
 
 use glam::{Mat3, Vec3};
@@ -94,7 +94,7 @@ impl CoarseAssembly {
         let mut corner_offsets = vec![0u32];
         let mut beta = Vec::new();
         let mut tet_group = Vec::with_capacity(tets.len());
-        let mut by_corners: HashMap<Vec<u32>, usize> = HashMap::new();
+        let mut by_corners: HashMap<Vec<u32>, usize> = HashMap::default();
         let mut members: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
         let mut ids: Vec<u32> = Vec::with_capacity(MAX_CORNERS);
         for (t, (tet, b)) in tets.iter().zip(b).enumerate() {

@@ -5,7 +5,7 @@
 //! enough of the free nodes' weight, with columns of `P` independent of the others', are
 //! kept, so the coarse unknowns follow the body's shape and its cuts, not its bounding box.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 use glam::{UVec3, Vec3};
 use rayon::prelude::*;
@@ -146,7 +146,7 @@ fn corner_weights(points: &[Vec3], free: &[bool], cell: f32) -> Vec<NodeWeights>
         .iter()
         .fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p))
         - Vec3::splat(0.5 * cell);
-    let mut ids: HashMap<UVec3, u32> = HashMap::new();
+    let mut ids: HashMap<UVec3, u32> = HashMap::default();
     let mut weights = vec![[(0u32, 0.0f32); 8]; points.len()];
     for (i, p) in points.iter().enumerate() {
         if !free[i] {
@@ -219,11 +219,11 @@ const MAX_CHECKED: usize = 1024;
 /// dependent (the coarse matrix singular). Columns of different fragments share no node.
 fn independent(kept: Vec<usize>, weights: &[NodeWeights], pieces: &Pieces) -> Vec<usize> {
     let fragment_of = |s: usize| pieces.fragment[s / 8];
-    let mut by_fragment: HashMap<u32, Vec<usize>> = HashMap::new();
+    let mut by_fragment: HashMap<u32, Vec<usize>> = HashMap::default();
     for &s in &kept {
         by_fragment.entry(fragment_of(s)).or_default().push(s);
     }
-    let mut nodes_of: HashMap<u32, Vec<usize>> = HashMap::new();
+    let mut nodes_of: HashMap<u32, Vec<usize>> = HashMap::default();
     for (i, f) in pieces.fragment.iter().enumerate() {
         if by_fragment.contains_key(f) {
             nodes_of.entry(*f).or_default().push(i);

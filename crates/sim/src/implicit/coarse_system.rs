@@ -9,7 +9,7 @@
 //! rotations and large strains the rest stiffness gets wrong; the fine level corrects the
 //! rest either way: this is only the preconditioner's coarse part.
 
-use std::collections::{HashMap, HashSet};
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -82,7 +82,7 @@ impl CoarseSystem {
         mass: &[f32],
         inv_h2: f32,
     ) -> Result<Self, CoarseError> {
-        let mut sets: HashSet<Vec<u32>> = HashSet::new();
+        let mut sets: HashSet<Vec<u32>> = HashSet::default();
         let mut ids = [0u32; 32];
         for t in tets {
             let mut n = 0;
@@ -97,7 +97,7 @@ impl CoarseSystem {
                 sets.insert(ids[..n].to_vec());
             }
         }
-        let mut index = HashMap::new();
+        let mut index = HashMap::default();
         let mut blocks = Vec::new();
         for ids in &sets {
             for (j, &w) in ids.iter().enumerate() {
