@@ -710,19 +710,26 @@ mod tests {
         );
     }
 
-    /// The product over the chunks with a free node is the product over every chunk: on a
-    /// block whose only free nodes are one node and the far half, so that whole chunks
-    /// have no free node and are skipped, and the lone node is each of its tets' corners
-    /// in turn.
-    #[test]
-    fn the_product_skips_only_tets_without_a_free_node() {
-        let (mesh, mut ws, _) = setup_with(true);
-        let n = mesh.node_count();
+    /// The lanes' block whose only free nodes are one lone node (corner 2 of tet 40) and
+    /// the far quarter, so that whole chunks of tets have no free node; every seventh tet
+    /// released.
+    fn mostly_fixed() -> (TetMesh, NewtonWorkspace, Vec<bool>, Vec<bool>) {
+        let (mesh, ws, _) = setup_with(true);
         let lone = mesh.tets[40][2] as usize;
-        let free: Vec<bool> = (0..n)
+        let free = (0..mesh.node_count())
             .map(|i| i == lone || mesh.rest_positions[i].x > 0.0301)
             .collect();
-        let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 7 != 2).collect();
+        let live = (0..mesh.tet_count()).map(|t| t % 7 != 2).collect();
+        (mesh, ws, free, live)
+    }
+
+    /// The product over the chunks with a free node is the product over every chunk, on
+    /// [`mostly_fixed`]: whole chunks are skipped, and the lone node is each of its tets'
+    /// corners in turn.
+    #[test]
+    fn the_product_skips_only_tets_without_a_free_node() {
+        let (mesh, mut ws, free, live) = mostly_fixed();
+        let n = mesh.node_count();
         let u = wobble(n, 1e-3);
         let p = wobble(n + 5, 1.0)[5..].to_vec();
         ws.hessian.evaluate(&u, &u, &live, &free, false);
@@ -749,13 +756,8 @@ mod tests {
     /// nodes do not move.
     #[test]
     fn skipping_the_fixed_chunks_changes_no_bit_of_g() {
-        let (mesh, mut ws, _) = setup_with(true);
+        let (mesh, mut ws, free, live) = mostly_fixed();
         let n = mesh.node_count();
-        let lone = mesh.tets[40][2] as usize;
-        let free: Vec<bool> = (0..n)
-            .map(|i| i == lone || mesh.rest_positions[i].x > 0.0301)
-            .collect();
-        let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 7 != 2).collect();
         let start = wobble(n, 1e-3);
         let moved: Vec<Vec3> = start
             .iter()
