@@ -7,7 +7,7 @@
 
 use rustc_hash::FxHashMap as HashMap;
 
-use glam::{UVec3, Vec3};
+use glam::{UVec3, Vec3, Vec3A};
 use rayon::prelude::*;
 
 pub use super::coarse_pieces::NodeWeights;
@@ -66,19 +66,17 @@ impl CoarseGrid {
         }
     }
 
-    /// `Pᵀ r`: fine node vectors summed onto the coarse nodes (f64, 3 per node), each
-    /// coarse node's sum in fine-node order (the same on any thread count).
+    /// `Pᵀ r`: fine node vectors summed onto the coarse nodes (in f32 SIMD registers, then
+    /// written as f64, 3 per node, for the factor), each coarse node's sum in fine-node
+    /// order (the same on any thread count).
     pub fn restrict(&self, r: &[Vec3], out: &mut [f64], parallel: bool) {
         let node = |(c, o): (usize, &mut [f64])| {
             let range = self.transpose_offsets[c] as usize..self.transpose_offsets[c + 1] as usize;
-            let mut sum = [0.0f64; 3];
+            let mut sum = Vec3A::ZERO;
             for &(i, wk) in &self.transpose[range] {
-                let r = r[i as usize];
-                sum[0] += (wk * r.x) as f64;
-                sum[1] += (wk * r.y) as f64;
-                sum[2] += (wk * r.z) as f64;
+                sum += wk * Vec3A::from(r[i as usize]);
             }
-            o.copy_from_slice(&sum);
+            o.copy_from_slice(&[sum.x as f64, sum.y as f64, sum.z as f64]);
         };
         if parallel {
             out.par_chunks_mut(3)
@@ -99,7 +97,7 @@ impl CoarseGrid {
     /// `z + (P c)_i`: fine node `i`'s value `z` plus the coarse values `c` interpolated
     /// onto it, corner by corner (what the preconditioner's node pass adds).
     #[inline]
-    pub fn add_prolonged(&self, i: usize, c: &[Vec3], z: Vec3) -> Vec3 {
+    pub fn add_prolonged(&self, i: usize, c: &[Vec3A], z: Vec3A) -> Vec3A {
         self.weights[i]
             .iter()
             .fold(z, |z, &(id, wk)| z + wk * c[id as usize])
@@ -351,12 +349,12 @@ mod tests {
             .collect();
         let mut pr = vec![0.0; 3 * grid.count];
         grid.restrict(&r, &mut pr, false);
-        let c3: Vec<Vec3> = c
+        let c3: Vec<Vec3A> = c
             .chunks(3)
-            .map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+            .map(|v| Vec3A::new(v[0] as f32, v[1] as f32, v[2] as f32))
             .collect();
         let z: Vec<Vec3> = (0..pts.len())
-            .map(|i| grid.add_prolonged(i, &c3, Vec3::ZERO))
+            .map(|i| grid.add_prolonged(i, &c3, Vec3A::ZERO).into())
             .collect();
         // In parallel: the same values.
         let mut pr2 = vec![1.0; 3 * grid.count];

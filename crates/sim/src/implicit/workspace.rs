@@ -65,7 +65,7 @@ struct TwoLevel {
     /// The coarse right-hand side and solution (f64, three per coarse node).
     rhs: Vec<f64>,
     /// The coarse solution in f32 (each value rounded once), what the fine nodes read.
-    coarse: Vec<Vec3>,
+    coarse: Vec<Vec3A>,
 }
 
 /// Buffers and the preconditioner of the implicit scheme for one body.
@@ -462,7 +462,7 @@ impl TwoLevel {
         self.coarse.extend(
             self.rhs
                 .chunks_exact(3)
-                .map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)),
+                .map(|v| Vec3A::new(v[0] as f32, v[1] as f32, v[2] as f32)),
         );
         let smoothed = match (&self.matrix, smooth) {
             (Some(m), true) => {
@@ -477,7 +477,7 @@ impl TwoLevel {
                 Vec3::ZERO
             } else {
                 let fine = if smoothed { *z } else { diag_inv[i] * r[i] };
-                grid.add_prolonged(i, coarse, fine)
+                grid.add_prolonged(i, coarse, fine.into()).into()
             };
         });
     }
