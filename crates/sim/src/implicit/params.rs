@@ -43,7 +43,7 @@ pub struct NewtonParams {
     /// Most conjugate-gradient products per Newton iteration.
     pub cg_iterations: u32,
     /// The conjugate gradient stops when the preconditioned residual falls below this
-    /// fraction of its first value (default 0.5: an inexact Newton step, the gradient and
+    /// fraction of its first value (default 0.3: an inexact Newton step, the gradient and
     /// step stops decide how converged the step is; docs/physics-notes.md "The CG
     /// tolerance").
     pub cg_tolerance: f32,
@@ -99,7 +99,7 @@ impl Default for NewtonParams {
             steps: 1,
             iterations: 5,
             cg_iterations: 100,
-            cg_tolerance: 0.5,
+            cg_tolerance: 0.3,
             gradient_tolerance: 0.01,
             step_tolerance: 0.01,
             coarse_cell: None,
