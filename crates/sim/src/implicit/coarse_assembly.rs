@@ -81,16 +81,22 @@ pub struct CoarseAssembly {
     parts: Vec<Vec<[f64; 9]>>,
 }
 
-impl CoarseAssembly {
-    /// The corners and pairs of every tet of `tets` (shape gradients `b`) on `grid`;
-    /// `index` maps a lower-triangle coarse block `(row, col)` to its index (it holds every
-    /// pair two nodes of one tet interpolate from).
-    pub fn new(
-        grid: &CoarseGrid,
-        tets: &[RestTet],
-        b: &[[Vec3; 4]],
-        index: &HashMap<(u32, u32), usize>,
-    ) -> Self {
+/// The tets of a mesh grouped by their coarse corners on a grid: per tet its corners'
+/// `β_j`, and the distinct corner sets with their tets — what both the coarse matrix's
+/// pattern and its assembly are built from, found once.
+#[derive(Debug, Clone)]
+pub struct Grouping {
+    tet_group: Vec<u32>,
+    corner_offsets: Vec<u32>,
+    beta: Vec<Vec3>,
+    /// Per group, its corners (descending coarse id) and its tets.
+    members: Vec<(Vec<u32>, Vec<u32>)>,
+}
+
+impl Grouping {
+    /// The corners (those with a nonzero weight at one of its nodes) of every tet of
+    /// `tets` (shape gradients `b`) on `grid`, grouped by corner set.
+    pub fn new(grid: &CoarseGrid, tets: &[RestTet], b: &[[Vec3; 4]]) -> Self {
         let mut corner_offsets = vec![0u32];
         let mut beta = Vec::new();
         let mut tet_group = Vec::with_capacity(tets.len());
@@ -107,17 +113,39 @@ impl CoarseAssembly {
             }
             ids.clear();
             ids.extend(corners.iter().map(|c| c.0));
-            let g = match by_corners.get(ids.as_slice()) {
-                Some(&g) => g,
-                None => {
-                    by_corners.insert(ids.clone(), members.len());
-                    members.push((ids.clone(), Vec::new()));
-                    members.len() - 1
-                }
-            };
+            let g = *by_corners.entry(ids.clone()).or_insert_with(|| {
+                members.push((ids.clone(), Vec::new()));
+                members.len() - 1
+            });
             members[g].1.push(t as u32);
             tet_group.push(g as u32);
         }
+        Grouping {
+            tet_group,
+            corner_offsets,
+            beta,
+            members,
+        }
+    }
+
+    /// The distinct corner sets, each in descending coarse id.
+    pub fn corner_sets(&self) -> impl Iterator<Item = &[u32]> {
+        self.members.iter().map(|(ids, _)| ids.as_slice())
+    }
+}
+
+impl CoarseAssembly {
+    /// The pairs of every group of `grouping` (the tets of `tets`, by their corners);
+    /// `index` maps a lower-triangle coarse block `(row, col)` to its index (it holds every
+    /// pair of one group's corners: [`super::CoarseSystem::mass_only`] on
+    /// [`Grouping::corner_sets`]).
+    pub fn new(grouping: Grouping, tets: &[RestTet], index: &HashMap<(u32, u32), usize>) -> Self {
+        let Grouping {
+            tet_group,
+            corner_offsets,
+            beta,
+            members,
+        } = grouping;
         let mut this = CoarseAssembly {
             tet_group,
             corner_offsets,
@@ -432,8 +460,8 @@ mod tests {
         // The pattern's factor needs a mass; the blocks compared below leave it out.
         let mass = mesh.lumped_masses(1040.0);
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
-        let sys = CoarseSystem::mass_only(&grid, &tets, &mass, 3600.0).unwrap();
-        let mut asm = CoarseAssembly::new(&grid, &tets, &b, sys.block_index());
+        let (sys, mut asm) =
+            CoarseSystem::with_assembly(&grid, (&tets, &b), (&mass, 3600.0)).unwrap();
         // Displacements: a quarter turn's worth of rotation about z plus a stretch in x
         // and a wobble, so F is far from I and the tangent far from its rest value.
         let rot = Mat3::from_rotation_z(0.6);

@@ -402,8 +402,12 @@ mod tests {
         };
         let grid = CoarseGrid::new(&pts, &free, 1.0, (&[tet], &[true]));
         assert_eq!(grid.count, 3, "{:?}", grid.weights);
-        let system =
-            super::super::coarse_system::CoarseSystem::mass_only(&grid, &[tet], &[1.0; 5], 1.0);
+        let b = [crate::vbd::shape_gradients(&tet.dm_inv)];
+        let system = super::super::coarse_system::CoarseSystem::with_assembly(
+            &grid,
+            (&[tet], &b),
+            (&[1.0; 5], 1.0),
+        );
         assert!(system.is_ok(), "{:?}", system.err());
     }
 
@@ -440,7 +444,15 @@ mod tests {
             }
         }
         let mass = mesh.lumped_masses(1040.0);
-        super::super::coarse_system::CoarseSystem::mass_only(&split, &tets, &mass, 3600.0)
-            .expect("factorises");
+        let b: Vec<_> = tets
+            .iter()
+            .map(|t| crate::vbd::shape_gradients(&t.dm_inv))
+            .collect();
+        super::super::coarse_system::CoarseSystem::with_assembly(
+            &split,
+            (&tets, &b),
+            (&mass, 3600.0),
+        )
+        .expect("factorises");
     }
 }

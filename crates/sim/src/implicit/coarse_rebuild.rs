@@ -82,8 +82,11 @@ fn rebuild(
     if grid.count > max_nodes || grid.weights == current {
         return Ok(None);
     }
-    let system = CoarseSystem::mass_only(&grid, &inputs.tets, &inputs.mass, inputs.inv_h2)?;
-    let assembly = CoarseAssembly::new(&grid, &inputs.tets, &inputs.b, system.block_index());
+    let (system, assembly) = CoarseSystem::with_assembly(
+        &grid,
+        (&inputs.tets, &inputs.b),
+        (&inputs.mass, inputs.inv_h2),
+    )?;
     Ok(Some(Rebuilt {
         grid,
         system,

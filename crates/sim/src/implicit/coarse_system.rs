@@ -9,7 +9,7 @@
 //! rotations and large strains the rest stiffness gets wrong; the fine level corrects the
 //! rest either way: this is only the preconditioner's coarse part.
 
-use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
+use rustc_hash::FxHashMap as HashMap;
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -17,7 +17,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{MatMut, Side};
 use glam::{Mat3, Vec3};
 
-use super::coarse_assembly::CoarseAssembly;
+use super::coarse_assembly::{CoarseAssembly, Grouping};
 use super::coarse_grid::CoarseGrid;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
@@ -58,51 +58,50 @@ pub struct CoarseSystem {
 impl CoarseSystem {
     /// `Pᵀ (M/h² + K_rest) P` over `tets` (shape gradients `b`, every one live) and the
     /// nodes' `mass`, factorised, with the assembly that refreshes it: the pattern of
-    /// [`CoarseSystem::mass_only`] filled as a refresh at the tangent `rest` (at rest,
+    /// [`CoarseSystem::with_assembly`] filled as a refresh at the tangent `rest` (at rest,
     /// linear elasticity), so the tets are summed by corner group in SIMD lanes, not pair
     /// by pair.
     pub fn at_rest(
         grid: &CoarseGrid,
-        (tets, b): (&[RestTet], &[[Vec3; 4]]),
-        (mass, inv_h2): (&[f32], f32),
+        tets: (&[RestTet], &[[Vec3; 4]]),
+        mass: (&[f32], f32),
         rest: &TetTangent,
         parallel: bool,
     ) -> Result<(Self, CoarseAssembly), CoarseError> {
-        let mut system = Self::mass_only(grid, tets, mass, inv_h2)?;
-        let mut assembly = CoarseAssembly::new(grid, tets, b, &system.index);
+        let (mut system, mut assembly) = Self::with_assembly(grid, tets, mass)?;
         system.refresh(&mut assembly, |_| Some(rest), parallel)?;
         Ok((system, assembly))
     }
 
-    /// `Pᵀ (M/h²) P` on the pattern of every pair of coarse nodes a tet of `tets`
-    /// interpolates from, factorised: what a refresh then fills with the tangents.
-    pub fn mass_only(
+    /// `Pᵀ (M/h²) P` on the pattern of `tets`' corner pairs (shape gradients `b`, lumped
+    /// `mass`), factorised, with the assembly a refresh fills it by: the tets are grouped
+    /// by corner set once, for both ([`Grouping`]).
+    pub fn with_assembly(
         grid: &CoarseGrid,
-        tets: &[RestTet],
+        (tets, b): (&[RestTet], &[[Vec3; 4]]),
+        (mass, inv_h2): (&[f32], f32),
+    ) -> Result<(Self, CoarseAssembly), CoarseError> {
+        let grouping = Grouping::new(grid, tets, b);
+        let system = Self::mass_only(grid, grouping.corner_sets(), mass, inv_h2)?;
+        let assembly = CoarseAssembly::new(grouping, tets, &system.index);
+        Ok((system, assembly))
+    }
+
+    /// `Pᵀ (M/h²) P` on the pattern of every pair of coarse nodes within one of the
+    /// `corner_sets` (each the coarse nodes one tet interpolates from), factorised: what
+    /// a refresh then fills with the tangents.
+    pub fn mass_only<'a>(
+        grid: &CoarseGrid,
+        corner_sets: impl IntoIterator<Item = &'a [u32]>,
         mass: &[f32],
         inv_h2: f32,
     ) -> Result<Self, CoarseError> {
-        let mut sets: HashSet<Vec<u32>> = HashSet::default();
-        let mut ids = [0u32; 32];
-        for t in tets {
-            let mut n = 0;
-            for &(id, w) in t.nodes.iter().flat_map(|&i| &grid.weights[i as usize]) {
-                if w != 0.0 && !ids[..n].contains(&id) {
-                    ids[n] = id;
-                    n += 1;
-                }
-            }
-            ids[..n].sort_unstable();
-            if !sets.contains(&ids[..n]) {
-                sets.insert(ids[..n].to_vec());
-            }
-        }
         let mut index = HashMap::default();
         let mut blocks = Vec::new();
-        for ids in &sets {
-            for (j, &w) in ids.iter().enumerate() {
-                for &v in &ids[j..] {
-                    add_block(&mut index, &mut blocks, (v, w), &Mat3::ZERO);
+        for ids in corner_sets {
+            for (j, &v) in ids.iter().enumerate() {
+                for &w in &ids[j..] {
+                    add_block(&mut index, &mut blocks, (v.max(w), v.min(w)), &Mat3::ZERO);
                 }
             }
         }
