@@ -128,21 +128,28 @@ impl CoarseLevel {
     }
 
     /// Re-assemble the matrix from the positive semi-definite part
-    /// ([`TetTangent::definite`]) of the `tangents` (one per tet, mesh order) of the tets
-    /// marked `live` and refactorise; on an error (not positive definite) the previous
-    /// factor stays, while the blocks are these tangents'. First the rebuild started at the
-    /// last refresh is taken, and where tets were released since, the next one starts
-    /// ([`super::coarse_rebuild`]).
+    /// ([`TetTangent::definite`]) of `tangent(t)` (mesh order; on the pool's threads when
+    /// `parallel`) of the tets marked `live` and refactorise; on an error (not positive
+    /// definite) the previous factor stays, while the blocks are these tangents'. First the
+    /// rebuild started at the last refresh is taken, and where tets were released since,
+    /// the next one starts ([`super::coarse_rebuild`]).
     pub fn refresh(
         &mut self,
-        tangents: impl Iterator<Item = TetTangent>,
+        tangent: impl Fn(usize) -> TetTangent + Sync,
         live: &[bool],
         parallel: bool,
     ) -> Result<(), CoarseError> {
         let rebuilt = self.take_rebuild();
         self.start_rebuild(live);
         self.used.clear();
-        self.used.extend(tangents.map(|t| t.definite()));
+        let definite = |t: usize| tangent(t).definite();
+        if parallel {
+            use rayon::prelude::*;
+            self.used
+                .par_extend((0..live.len()).into_par_iter().map(definite));
+        } else {
+            self.used.extend((0..live.len()).map(definite));
+        }
         self.in_coarse.clear();
         self.in_coarse.extend_from_slice(live);
         self.since_refresh = 0;

@@ -238,8 +238,7 @@ impl NewtonWorkspace {
     /// it (the previous factor stays where the new one fails).
     fn refresh_coarse(&mut self, live: &[bool], parallel: bool) -> Result<(), CoarseError> {
         let evals = &self.hessian.evals;
-        let tangents = (0..live.len()).map(|t| evals.tangent(t));
-        let done = self.pre.level.refresh(tangents, live, parallel);
+        let done = self.pre.level.refresh(|t| evals.tangent(t), live, parallel);
         self.pre.rhs.resize(3 * self.pre.level.grid.count, 0.0);
         done
     }

@@ -101,11 +101,12 @@ impl HostCoarse {
     /// Re-assemble the coarse matrix from the tangents at the displacements `u` of the
     /// tets marked `live` (mesh order) and refactorise; on an error (not positive
     /// definite) the previous factor stays. The tangents are those of the step's first
-    /// iterate, as on the CPU.
+    /// iterate, as on the CPU; computed on the host's pool (the sums run in fixed parts,
+    /// so the result does not depend on its size).
     pub fn refresh(&mut self, u: &[Vec3], live: &[bool]) -> Result<(), CoarseError> {
-        let lame = self.lame;
-        let tangents = self.tets.iter().map(|t| TetTangent::at(&t.strain(u), lame));
-        self.level.refresh(tangents, live, false)
+        let (lame, tets) = (self.lame, &self.tets);
+        let tangent = |t: usize| TetTangent::at(&tets[t].strain(u), lame);
+        self.level.refresh(tangent, live, true)
     }
 
     /// One more step since the last refresh.
