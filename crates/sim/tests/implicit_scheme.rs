@@ -217,6 +217,46 @@ fn newton_gives_the_same_bits_on_any_thread_count() {
     }
 }
 
+/// Each frame's stats report its Newton work: at least one iteration a frame and no more
+/// than the settings allow, a product per iteration at least, the iterations stopped at
+/// negative curvature among them, and line-search halvings once the bar has torn; under
+/// XPBD all of it is zero.
+#[test]
+fn each_frame_reports_its_newton_work() {
+    let params = NewtonParams::default();
+    let mut s = common::tearing_bar_with(|p| {
+        p.threads = 1;
+        p.scheme = Scheme::Newton(params);
+    });
+    let (mut halvings, mut curvature) = (0, 0);
+    for f in 0..45 {
+        let st = s.step_frame().unwrap();
+        let most = params.steps * params.iterations;
+        assert!(
+            (1..=most).contains(&st.newton_iterations),
+            "frame {f}: {} Newton iterations",
+            st.newton_iterations
+        );
+        assert!(st.cg_products >= st.newton_iterations, "frame {f}: {st:?}");
+        assert!(st.negative_curvature <= st.newton_iterations, "frame {f}");
+        halvings += st.line_search_halvings;
+        curvature += st.negative_curvature;
+    }
+    assert!(s.cut().released_count() > 0, "the bar should tear");
+    assert!(
+        halvings + curvature > 0,
+        "no halving or negative curvature in a tear"
+    );
+    let mut xpbd = common::tearing_bar(1);
+    let st = xpbd.step_frame().unwrap();
+    let newton_work = [
+        st.newton_iterations,
+        st.cg_products,
+        st.line_search_halvings,
+    ];
+    assert_eq!(newton_work, [0, 0, 0], "XPBD reports Newton work");
+}
+
 /// A soft cantilever bent a quarter of its length under gravity: the rest stiffness
 /// misses the rotation of its tets, so the coarse level refreshed from the current
 /// tangents needs fewer products a frame once bent, and both settle on the same sag; the

@@ -25,7 +25,7 @@ mod workspace;
 pub use coarse_grid::CoarseGrid;
 pub use coarse_level::CoarseLevel;
 pub use coarse_system::{CoarseError, CoarseSystem};
-pub use newton_report::NewtonReport;
+pub use newton_report::{FrameCost, NewtonReport};
 pub use params::{CoarseRefresh, NewtonParams, Scheme, Smoother};
 pub use pcg::{CgReport, dot, pcg};
 pub use rest_tet::RestTet;

@@ -23,3 +23,30 @@ pub struct NewtonReport {
     /// grid (docs/physics-notes.md, "The coarse level after a cut").
     pub coarse_nodes: u32,
 }
+
+/// What a frame's implicit steps cost, summed over its steps (what the frame's stats
+/// report).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FrameCost {
+    /// Newton iterations.
+    pub iterations: u32,
+    /// Hessian–vector products.
+    pub cg_products: u32,
+    /// Iterations whose conjugate gradient met non-positive curvature.
+    pub negative_curvature: u32,
+    /// Step halvings of the line search.
+    pub halvings: u32,
+    /// Steps that re-assembled the coarse matrix.
+    pub coarse_refreshes: u32,
+}
+
+impl FrameCost {
+    /// Add one step's report.
+    pub fn add(&mut self, r: &NewtonReport) {
+        self.iterations += r.iterations;
+        self.cg_products += r.cg_products;
+        self.negative_curvature += r.negative_curvature;
+        self.halvings += r.halvings;
+        self.coarse_refreshes += u32::from(r.coarse_refreshed);
+    }
+}

@@ -43,6 +43,13 @@ pub struct FrameStats {
     pub passes: u32,
     /// Conjugate-gradient products of the frame's Newton iterations (0 under XPBD).
     pub cg_products: u32,
+    /// Newton iterations of the frame's implicit steps (0 under XPBD).
+    pub newton_iterations: u32,
+    /// Of those, the iterations whose conjugate gradient stopped at non-positive
+    /// curvature (a torn organ's indefinite tangent).
+    pub negative_curvature: u32,
+    /// Step halvings of the Newton line searches (0 under XPBD).
+    pub line_search_halvings: u32,
     /// Implicit steps of the frame that re-assembled the coarse matrix (0 under XPBD).
     pub coarse_refreshes: u32,
     /// Coarse nodes of the implicit scheme's preconditioner at the frame's end (0 under

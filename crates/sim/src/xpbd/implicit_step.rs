@@ -51,7 +51,7 @@ impl Solver {
         let mut fresh = false;
         self.check_ms = 0.0;
         self.passes = checks.len() as u32;
-        self.implicit_cost = (0, 0);
+        self.implicit_cost = Default::default();
         for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
@@ -73,8 +73,7 @@ impl Solver {
             if let Some(ws) = &mut self.newton {
                 ws.solve(&mut self.u, &y, &live, &free, parallel);
                 let r = ws.last;
-                self.implicit_cost.0 += r.cg_products;
-                self.implicit_cost.1 += u32::from(r.coarse_refreshed);
+                self.implicit_cost.add(&r);
                 self.coarse_nodes = r.coarse_nodes;
                 // A tet pass and a node pass per evaluation, product and gather.
                 self.passes +=

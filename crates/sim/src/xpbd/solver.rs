@@ -91,8 +91,8 @@ pub struct Solver {
     pub(crate) check_ms: f64,
     /// Parallel passes of the last frame (colours per substep, stress passes).
     pub(crate) passes: u32,
-    /// The last frame's conjugate-gradient products and coarse refreshes (Newton).
-    pub(crate) implicit_cost: (u32, u32),
+    /// What the last frame's implicit steps cost (Newton).
+    pub(crate) implicit_cost: crate::implicit::FrameCost,
     /// Coarse nodes after the last implicit step (0 under XPBD).
     pub(crate) coarse_nodes: u32,
     pub(crate) pool: Option<rayon::ThreadPool>,
@@ -204,7 +204,7 @@ impl Solver {
             time: 0.0,
             check_ms: 0.0,
             passes: 0,
-            implicit_cost: (0, 0),
+            implicit_cost: Default::default(),
             coarse_nodes: 0,
             pool,
             newton: None,
@@ -880,8 +880,11 @@ impl Solver {
             check_ms: 0.0,
             stress_ms: 0.0,
             passes: self.passes,
-            cg_products: self.implicit_cost.0,
-            coarse_refreshes: self.implicit_cost.1,
+            cg_products: self.implicit_cost.cg_products,
+            newton_iterations: self.implicit_cost.iterations,
+            negative_curvature: self.implicit_cost.negative_curvature,
+            line_search_halvings: self.implicit_cost.halvings,
+            coarse_refreshes: self.implicit_cost.coarse_refreshes,
             coarse_nodes: self.coarse_nodes,
         }
     }

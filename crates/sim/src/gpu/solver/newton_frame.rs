@@ -40,7 +40,7 @@ impl GpuSolver {
         let nodes = self.host.x.len();
         let mut fresh = false;
         let mut dispatches = 0;
-        self.host.implicit_cost = (0, 0);
+        self.host.implicit_cost = Default::default();
         for s in 0..n as usize {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -71,8 +71,7 @@ impl GpuSolver {
             };
             enc = newton.solve_step(&dev, &live, enc)?;
             let r = newton.last;
-            self.host.implicit_cost.0 += r.cg_products;
-            self.host.implicit_cost.1 += u32::from(r.coarse_refreshed);
+            self.host.implicit_cost.add(&r);
             self.host.coarse_nodes = r.coarse_nodes;
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("newton step end"),
