@@ -137,8 +137,8 @@ impl Grouping {
 impl CoarseAssembly {
     /// The pairs of every group of `grouping` (the tets of `tets`, by their corners);
     /// `index` maps a lower-triangle coarse block `(row, col)` to its index (it holds every
-    /// pair of one group's corners: [`super::CoarseSystem::mass_only`] on
-    /// [`Grouping::corner_sets`]).
+    /// pair of one group's corners, as [`super::CoarseSystem::with_assembly`] builds it
+    /// from [`Grouping::corner_sets`]).
     pub fn new(grouping: Grouping, tets: &[RestTet], index: &HashMap<(u32, u32), usize>) -> Self {
         let Grouping {
             tet_group,

@@ -90,7 +90,7 @@ impl CoarseSystem {
     /// `Pᵀ (M/h²) P` on the pattern of every pair of coarse nodes within one of the
     /// `corner_sets` (each the coarse nodes one tet interpolates from), factorised: what
     /// a refresh then fills with the tangents.
-    pub fn mass_only<'a>(
+    fn mass_only<'a>(
         grid: &CoarseGrid,
         corner_sets: impl IntoIterator<Item = &'a [u32]>,
         mass: &[f32],
