@@ -33,6 +33,10 @@ pub(crate) struct Kernels {
     /// `neo_hookean.wgsl`'s `project_groups`: one phase of the partitioned order.
     pub project_groups: wgpu::ComputePipeline,
     pub contact: wgpu::ComputePipeline,
+    /// `contact.wgsl`'s `hold`: the blade before an implicit step's solve.
+    pub contact_hold: wgpu::ComputePipeline,
+    /// `contact.wgsl`'s `resolve`: the nodes a solve carried into the tool, held.
+    pub contact_resolve: wgpu::ComputePipeline,
     pub velocity: wgpu::ComputePipeline,
     pub stress: wgpu::ComputePipeline,
     pub release: wgpu::ComputePipeline,
@@ -66,6 +70,8 @@ impl Kernels {
             project: make("neo_hookean"),
             project_groups: make_entry("neo_hookean", "project_groups"),
             contact: make("contact"),
+            contact_hold: make_entry("contact", "hold"),
+            contact_resolve: make_entry("contact", "resolve"),
             velocity: make("velocity"),
             stress: make("stress"),
             release: make("release"),

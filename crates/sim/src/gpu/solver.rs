@@ -62,6 +62,10 @@ struct Buffers {
     tool: wgpu::Buffer,
     push: wgpu::Buffer,
     near_edge: wgpu::Buffer,
+    /// Nodes the tool held or pushed in the last implicit step (the host's `touched`).
+    touch: wgpu::Buffer,
+    /// How many nodes the contact kernel's `resolve` held (one counter).
+    moved: wgpu::Buffer,
 }
 
 /// Bind groups for every dispatch of a frame.
@@ -74,6 +78,10 @@ struct Bindings {
     phase_steps: Vec<wgpu::BindGroup>,
     contact: wgpu::BindGroup,
     contact_steps: Vec<wgpu::BindGroup>,
+    contact_hold: wgpu::BindGroup,
+    hold_steps: Vec<wgpu::BindGroup>,
+    contact_resolve: wgpu::BindGroup,
+    resolve_steps: Vec<wgpu::BindGroup>,
     velocity: wgpu::BindGroup,
     stress: wgpu::BindGroup,
     release: wgpu::BindGroup,
@@ -90,6 +98,7 @@ struct Readback {
     released: wgpu::Buffer,
     push: wgpu::Buffer,
     near_edge: wgpu::Buffer,
+    moved: wgpu::Buffer,
 }
 
 struct Timestamps {
@@ -341,6 +350,19 @@ impl GpuSolver {
             tool: storage(&device, "tool", &[0u8; 16], none),
             push: storage(&device, "contact push", &vec![0u8; n * 16], none),
             near_edge: storage(&device, "near edge", &vec![0u8; n * 4], none),
+            touch: storage(
+                &device,
+                "touched",
+                bytemuck::cast_slice(
+                    &host
+                        .touched
+                        .iter()
+                        .map(|&t| u32::from(t))
+                        .collect::<Vec<u32>>(),
+                ),
+                none,
+            ),
+            moved: storage(&device, "held by resolve", &[0u8; 4], none),
         };
         let b = &buf;
         let group =
@@ -414,6 +436,14 @@ impl GpuSolver {
             contact_steps: (0..substeps)
                 .map(|s| step_group(&kernels.contact, s))
                 .collect(),
+            contact_hold: hold_group(&device, &kernels, b),
+            hold_steps: (0..substeps)
+                .map(|s| step_group(&kernels.contact_hold, s))
+                .collect(),
+            contact_resolve: resolve_group(&device, &kernels, b),
+            resolve_steps: (0..substeps)
+                .map(|s| step_group(&kernels.contact_resolve, s))
+                .collect(),
             velocity: group(
                 &kernels.velocity,
                 0,
@@ -460,6 +490,7 @@ impl GpuSolver {
             released: staging(&device, "read released", 4 + slots as u64 * 4),
             push: staging(&device, "read contact push", n as u64 * 16),
             near_edge: staging(&device, "read near edge", n as u64 * 4),
+            moved: staging(&device, "read held by resolve", 4),
         };
         let newton = GpuNewton::new(
             &device,
@@ -470,6 +501,7 @@ impl GpuSolver {
                 rest: &buf.rest,
                 live: &buf.live,
                 kind: &buf.kind,
+                push: &buf.push,
             },
             (&ctx.info.name, ctx.max_binding),
         )?;
@@ -720,6 +752,8 @@ impl GpuSolver {
             if bytes.len() as u64 > self.buf.tool.size() {
                 self.buf.tool = storage(&self.device, "tool", bytes, wgpu::BufferUsages::empty());
                 self.bind.contact = contact_group(&self.device, &self.kernels, &self.buf);
+                self.bind.contact_hold = hold_group(&self.device, &self.kernels, &self.buf);
+                self.bind.contact_resolve = resolve_group(&self.device, &self.kernels, &self.buf);
             } else {
                 self.queue.write_buffer(&self.buf.tool, 0, bytes);
             }
@@ -1073,18 +1107,72 @@ fn push_placed(words: &mut Vec<[f32; 4]>, placed: &PlacedTool) {
 
 /// The contact kernel's bind group (rebuilt when the tool buffer grows).
 fn contact_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu::BindGroup {
+    let list = [
+        &b.params,
+        &b.pos,
+        &b.prev,
+        &b.kind,
+        &b.rest_pos,
+        &b.tool,
+        &b.push,
+        &b.near_edge,
+        &b.touch,
+    ];
+    numbered_group(
+        device,
+        &kernels.contact,
+        "contact",
+        &list.iter().copied().zip(0..).collect::<Vec<_>>(),
+    )
+}
+
+/// The bind group of the contact kernel's `hold` (rebuilt with [`contact_group`]).
+fn hold_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu::BindGroup {
+    let list = [
+        (&b.params, 0),
+        (&b.pos, 1),
+        (&b.prev, 2),
+        (&b.kind, 3),
+        (&b.rest_pos, 4),
+        (&b.tool, 5),
+        (&b.near_edge, 7),
+        (&b.touch, 8),
+    ];
+    numbered_group(device, &kernels.contact_hold, "contact hold", &list)
+}
+
+/// The bind group of the contact kernel's `resolve` (rebuilt with [`contact_group`]).
+fn resolve_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu::BindGroup {
+    let list = [
+        (&b.params, 0),
+        (&b.pos, 1),
+        (&b.prev, 2),
+        (&b.kind, 3),
+        (&b.rest_pos, 4),
+        (&b.tool, 5),
+        (&b.near_edge, 7),
+        (&b.moved, 9),
+    ];
+    numbered_group(device, &kernels.contact_resolve, "contact resolve", &list)
+}
+
+/// Group 0 of `pipe` from buffers with their binding numbers.
+fn numbered_group(
+    device: &wgpu::Device,
+    pipe: &wgpu::ComputePipeline,
+    label: &str,
+    list: &[(&wgpu::Buffer, u32)],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = list
+        .iter()
+        .map(|(b, i)| wgpu::BindGroupEntry {
+            binding: *i,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("contact"),
-        layout: &kernels.contact.get_bind_group_layout(0),
-        entries: &entries(&[
-            &b.params,
-            &b.pos,
-            &b.prev,
-            &b.kind,
-            &b.rest_pos,
-            &b.tool,
-            &b.push,
-            &b.near_edge,
-        ]),
+        label: Some(label),
+        layout: &pipe.get_bind_group_layout(0),
+        entries: &entries,
     })
 }

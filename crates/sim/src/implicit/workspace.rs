@@ -234,6 +234,17 @@ impl NewtonWorkspace {
         self.last = report;
     }
 
+    /// `∂G/∂x` at `node` with the tet evaluations of the last iterate, `m/h² (u − y)` plus
+    /// the corner forces of its tets: after [`NewtonWorkspace::solve`] held the node fixed,
+    /// the force whatever held it (the tool's blade) pushes it with, N.
+    pub fn reaction(&self, u: &[Vec3], y: &[Vec3], node: usize) -> Vec3 {
+        let h = &self.hessian;
+        let inertia = (u[node] - y[node]) * (h.mass[node] * h.inv_h2);
+        h.incident(node).iter().fold(inertia, |g, &(t, a)| {
+            g + h.evals.force(t as usize, a as usize)
+        })
+    }
+
     /// Re-assemble the coarse matrix from the live tets' current tangents and refactorise
     /// it (the previous factor stays where the new one fails).
     fn refresh_coarse(&mut self, live: &[bool], parallel: bool) -> Result<(), CoarseError> {

@@ -1,13 +1,22 @@
 //! The tet solver's frame under `scheme: Newton`: `steps` implicit Euler steps, each the
 //! minimisation of `crate::implicit`'s `G` (prediction as the XPBD loop's, then Newton
-//! iterations instead of sweeps), then the tool contact, the velocity update with the
-//! same damping and the release checks on the same simulation-time schedule (PHYSICS.md
-//! §1.4), so stress, release and contact are those of the XPBD scheme.
+//! iterations instead of sweeps) with the nodes in the tool's path held where it pushes
+//! them (docs/physics-notes.md, "The implicit scheme under a blade"), then the tool contact
+//! for the nodes the solve carried into it, the velocity update with the same damping and
+//! the release checks on the same simulation-time schedule (PHYSICS.md §1.4), so stress,
+//! release and contact are those of the XPBD scheme.
 
 use super::release_schedule::release_checks;
 use super::solver::{NodeKind, Solver};
 use super::{CpuKernel, SolverError};
+use glam::Vec3;
+
 use crate::implicit::{NewtonParams, NewtonWorkspace, Scheme};
+
+/// Times a step's solve is repeated with the nodes it carried into the tool held too
+/// (docs/physics-notes.md, "The implicit scheme under a blade": one pass more brings the
+/// released tets to the reference's on plate_cut; a second costs more and gains nothing).
+const CONTACT_RESOLVES: usize = 1;
 
 impl Solver {
     /// Build the implicit scheme's workspace (coarse grid, its factorised matrix) now, if
@@ -55,13 +64,18 @@ impl Solver {
         for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
+            // PHYSICS.md §1.5 inside the step (docs/physics-notes.md, "The implicit scheme
+            // under a blade"): the nodes in the tool's path are held where it pushes them.
+            let mut held = vec![false; free.len()];
+            self.hold_contacts(s, n, &mut held);
+            // A held node's target is where the tool holds it.
             let y = self.u.clone();
             // Start from u + h v without this step's gravity: y itself drops every free
             // node by h²g (2.7 mm at 60 Hz, a tet's height) while the pins hold, which
             // crushes the tets along the pins in the first iterate.
             let fall = self.params.gravity * (h * h);
-            for (u, k) in self.u.iter_mut().zip(&self.kind) {
-                if *k == NodeKind::Free {
+            for (i, u) in self.u.iter_mut().enumerate() {
+                if free[i] && !held[i] {
                     *u -= fall;
                 }
             }
@@ -70,15 +84,22 @@ impl Solver {
                 .iter()
                 .map(|&slot| self.slots[slot as usize].live)
                 .collect();
-            if let Some(ws) = &mut self.newton {
-                ws.solve(&mut self.u, &y, &live, &free, parallel);
-                let r = ws.last;
-                self.implicit_cost.add(&r);
-                self.coarse_nodes = r.coarse_nodes;
-                // A tet pass and a node pass per evaluation, product and gather.
-                self.passes +=
-                    2 * (1 + r.iterations + r.halvings) + 2 * r.cg_products + r.iterations;
+            for pass in 0..=CONTACT_RESOLVES {
+                let step_free: Vec<bool> = free.iter().zip(&held).map(|(f, h)| *f && !*h).collect();
+                self.implicit_solve(&y, &live, &step_free, parallel);
+                if pass == CONTACT_RESOLVES {
+                    break;
+                }
+                // Nodes the solve carried into the tool: held too, and solved again.
+                let moved = self.contacts(s, n);
+                if moved.is_empty() {
+                    break;
+                }
+                for (i, _) in moved {
+                    held[i] = true;
+                }
             }
+            self.push_held(h, &y, &held);
             self.project_contacts(s, n);
             self.update_velocities(h);
             fresh = next.next_if(|&&k| k == s).is_some();
@@ -87,5 +108,30 @@ impl Solver {
             }
         }
         Ok(fresh)
+    }
+
+    /// One Newton solve of the step from `u` to the minimum of `G` (target `y`), the nodes
+    /// not `free` held; its cost booked.
+    fn implicit_solve(&mut self, y: &[Vec3], live: &[bool], free: &[bool], parallel: bool) {
+        if let Some(ws) = &mut self.newton {
+            ws.solve(&mut self.u, y, live, free, parallel);
+            let r = ws.last;
+            self.implicit_cost.add(&r);
+            self.coarse_nodes = r.coarse_nodes;
+            // A tet pass and a node pass per evaluation, product and gather.
+            self.passes += 2 * (1 + r.iterations + r.halvings) + 2 * r.cg_products + r.iterations;
+        }
+    }
+
+    /// The force that held each `held` node, `∂G/∂x` there (PHYSICS.md §1.5's contact
+    /// multiplier `λ = h² f`), booked as the tool's push.
+    fn push_held(&mut self, h: f32, y: &[Vec3], held: &[bool]) {
+        let Some(ws) = &self.newton else {
+            return;
+        };
+        for i in (0..held.len()).filter(|&i| held[i]) {
+            self.contact_push[i] += h * h * ws.reaction(&self.u, y, i);
+            self.touched[i] = true;
+        }
     }
 }

@@ -83,8 +83,12 @@ pub struct Solver {
     pub(crate) near_edge: Vec<bool>,
     /// The same since the last release check (what a `NearEdge` cut zone releases by).
     pub(crate) near_window: Vec<bool>,
-    /// Per node, Σ m Δx of the contact projections this frame (tissue side), kg·m.
+    /// Per node, Σ m Δx of the contact projections this frame (tissue side), kg·m; under
+    /// `scheme: Newton`, h² times the force that held a node in the blade's path.
     pub(crate) contact_push: Vec<Vec3>,
+    /// Nodes the tool held or pushed in the last implicit step (`scheme: Newton`): the
+    /// next step starts them where they were, in the blade's path.
+    pub(crate) touched: Vec<bool>,
     pub(crate) frame: u64,
     pub(crate) time: f64,
     /// Wall time of the release checks inside the last frame's substeps, ms.
@@ -200,6 +204,7 @@ impl Solver {
             near_edge: vec![false; n],
             near_window: vec![false; n],
             contact_push: vec![Vec3::ZERO; n],
+            touched: vec![false; n],
             frame: 0,
             time: 0.0,
             check_ms: 0.0,
@@ -484,7 +489,7 @@ impl Solver {
     /// frame is rolled back (tets switched off during it come back) and an error names the
     /// frame and the tet.
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
-        let saved = (self.u.clone(), self.v.clone());
+        let saved = (self.u.clone(), self.v.clone(), self.touched.clone());
         let t0 = Instant::now();
         self.near_edge.iter_mut().for_each(|b| *b = false);
         self.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
@@ -500,6 +505,7 @@ impl Solver {
             self.u = saved.0;
             self.u_prev.clone_from(&self.u);
             self.v = saved.1;
+            self.touched = saved.2;
             self.sync_positions();
             self.time -= self.params.frame_dt as f64;
             self.revive_pending();
@@ -602,8 +608,17 @@ impl Solver {
     /// with one iteration per substep the last projection is the one that holds, and
     /// this way every substep ends with no node inside the tool.
     pub(crate) fn project_contacts(&mut self, s: u32, n: u32) {
+        for (i, pushed) in self.contacts(s, n) {
+            self.contact_push[i] += self.mass[i] * pushed;
+            self.touched[i] = true;
+        }
+    }
+
+    /// Project every free node out of the tool over substep (or implicit step) `s` of `n`,
+    /// flagging the nodes near its edge; the nodes moved and by how much.
+    pub(crate) fn contacts(&mut self, s: u32, n: u32) -> Vec<(usize, Vec3)> {
         let Some(motion) = &self.tool else {
-            return;
+            return Vec::new();
         };
         let from = motion.placed_at(s, n);
         let to = motion.placed_at(s + 1, n);
@@ -612,6 +627,7 @@ impl Solver {
             CutZone::NearEdge { reach } => Some(reach),
             CutZone::Anywhere => None,
         };
+        let mut moved = Vec::new();
         for i in 0..self.u.len() {
             if self.kind[i] != NodeKind::Free {
                 continue;
@@ -621,10 +637,29 @@ impl Solver {
             let c = project_node(rest + self.u_prev[i], x, &from, &to, friction, reach);
             if c.moved {
                 self.u[i] = c.x - rest;
-                self.contact_push[i] += self.mass[i] * (c.x - x);
+                moved.push((i, c.x - x));
             }
             self.near_edge[i] |= c.near_edge;
             self.near_window[i] |= c.near_edge;
+        }
+        moved
+    }
+
+    /// The blade in the implicit step `s` of `n` (`scheme: Newton`), before its solve: the
+    /// nodes it touched in the last step start where they were, every free node is
+    /// projected out of the tool's path, and those it moved are marked `held` (the solve
+    /// keeps them fixed, so the tissue around them answers the push within the step).
+    pub(crate) fn hold_contacts(&mut self, s: u32, n: u32, held: &mut [bool]) {
+        if self.tool.is_none() {
+            return;
+        }
+        for i in 0..self.u.len() {
+            if std::mem::take(&mut self.touched[i]) && self.kind[i] == NodeKind::Free {
+                self.u[i] = self.u_prev[i];
+            }
+        }
+        for (i, _) in self.contacts(s, n) {
+            held[i] = true;
         }
     }
 

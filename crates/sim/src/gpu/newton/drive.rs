@@ -72,9 +72,25 @@ fn record(enc: &mut wgpu::CommandEncoder, list: &[Dispatch<'_>]) -> u32 {
 }
 
 impl GpuNewton {
-    /// Minimise `G` from the prediction in `pos` (written there by the predict kernel this
-    /// step); `enc` holds the commands recorded so far. `live` per tet (mesh order) is what
-    /// a coarse refresh assembles. Returns an encoder to record the rest of the frame in.
+    /// Record the step's start: the prediction in `pos` (written there by the predict
+    /// kernel, then the blade's held nodes by the contact kernel's `hold`) becomes the
+    /// target `y`, and the first iterate leaves out this step's fall at the free nodes.
+    pub fn start_step(&mut self, enc: &mut wgpu::CommandEncoder) {
+        let (ng, _, _) = self.groups;
+        self.dispatches += record(enc, &[(&self.kernels.start, &self.bind.nodes, ng)]);
+    }
+
+    /// Record the held nodes' reactions into the contact push (after the step's last
+    /// solve, before the contact kernel frees them).
+    pub fn record_reaction(&mut self, enc: &mut wgpu::CommandEncoder) {
+        let (ng, _, _) = self.groups;
+        self.dispatches += record(enc, &[(&self.kernels.reaction, &self.bind.nodes, ng)]);
+    }
+
+    /// Minimise `G` from the iterate in `pos` (after [`GpuNewton::start_step`], or as a
+    /// further solve of the step left it); `enc` holds the commands recorded so far.
+    /// `live` per tet (mesh order) is what a coarse refresh assembles. Returns an encoder
+    /// to record the rest of the frame in.
     pub fn solve_step(
         &mut self,
         dev: &OnDevice<'_>,
@@ -88,7 +104,7 @@ impl GpuNewton {
         self.dispatches += record(
             &mut enc,
             &[
-                (&k.start, &b.nodes, ng),
+                (&k.resume, &b.nodes, ng),
                 (&k.evaluate, &b.tets, tg),
                 (&k.gather, &b.nodes, ng),
             ],

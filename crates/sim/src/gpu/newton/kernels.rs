@@ -36,13 +36,14 @@ const TETS: [Slot; 7] = [
     Slot::Write,
     Slot::Write,
 ];
-const NODES: [Slot; 7] = [
+const NODES: [Slot; 8] = [
     Slot::Uniform,
     Slot::Write,
     Slot::Write,
     Slot::Read,
     Slot::Read,
     Slot::Read,
+    Slot::Write,
     Slot::Write,
 ];
 const CG: [Slot; 7] = [
@@ -69,6 +70,8 @@ pub(crate) struct NewtonKernels {
     pub inertia: wgpu::ComputePipeline,
     pub trial: wgpu::ComputePipeline,
     pub gather_product: wgpu::ComputePipeline,
+    pub resume: wgpu::ComputePipeline,
+    pub reaction: wgpu::ComputePipeline,
     pub restrict_init: wgpu::ComputePipeline,
     pub coarse_solve: wgpu::ComputePipeline,
     pub precondition_init: wgpu::ComputePipeline,
@@ -141,6 +144,8 @@ impl NewtonKernels {
             inertia: pipeline(&nodes, &nodes_layout, "inertia"),
             trial: pipeline(&nodes, &nodes_layout, "trial"),
             gather_product: pipeline(&nodes, &nodes_layout, "gather_product"),
+            resume: pipeline(&nodes, &nodes_layout, "resume"),
+            reaction: pipeline(&nodes, &nodes_layout, "reaction"),
             restrict_init: pipeline(&cg, &cg_layout, "restrict_init"),
             coarse_solve: pipeline(&cg, &cg_layout, "coarse_solve"),
             precondition_init: pipeline(&cg, &cg_layout, "precondition_init"),

@@ -35,6 +35,8 @@ pub(crate) struct Shared<'a> {
     pub live: &'a wgpu::Buffer,
     /// Node kinds.
     pub kind: &'a wgpu::Buffer,
+    /// The contact's per-node push (the held nodes' reactions go there).
+    pub push: &'a wgpu::Buffer,
 }
 
 /// The Newton kernels' own buffers.
@@ -260,6 +262,7 @@ impl GpuNewton {
                     &b.tet_out,
                     &b.inc,
                     &b.scratch,
+                    shared.push,
                 ],
             ),
             cg: self::bind(

@@ -43,6 +43,9 @@ const KIND_FREE: u32 = 0u;
 const KIND_PINNED: u32 = 1u;
 const KIND_RETIRED: u32 = 2u;
 const KIND_GRAB0: u32 = 3u;
+// A free node the tool holds through an implicit step's solve (set and cleared within the
+// step: contact.wgsl's hold/resolve and main).
+const KIND_HELD: u32 = 0xffffffffu;
 
 fn dm_inv_of(r: TetRest) -> mat3x3<f32> {
     return mat3x3<f32>(r.c0.xyz, r.c1.xyz, r.c2.xyz);

@@ -1,8 +1,10 @@
 // Tool contact (PHYSICS.md §1.5): C = d(x) >= 0 for every free node, projected after the
 // tet constraints of the substep, continuous over the substep (the node's path relative
-// to each primitive), with positional Coulomb friction. One thread per node.
+// to each primitive), with positional Coulomb friction. One thread per node. Under the
+// implicit scheme also before and between a step's solves, the nodes moved held
+// (docs/physics-notes.md, "The implicit scheme under a blade").
 // CPU twin: crates/sim/src/contact/projection.rs (project_node) and
-// Solver::project_contacts.
+// Solver::{project_contacts, hold_contacts, contacts}.
 //
 // tool: for each pose k = 0..=substeps (the tool at the end of substep k-1), a block of
 // 2 vec4 (lower and upper corner of the bounds of all primitives), sphere_count vec4
@@ -12,11 +14,15 @@
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read_write> pos: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> prev: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> kind: array<u32>;
+@group(0) @binding(3) var<storage, read_write> kind: array<u32>;
 @group(0) @binding(4) var<storage, read> rest_pos: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> tool: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> push: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read_write> near_edge: array<u32>;
+// Nodes the tool held or pushed in the last implicit step (CPU twin: Solver::touched).
+@group(0) @binding(8) var<storage, read_write> touch: array<u32>;
+// Nodes `resolve` held (one counter).
+@group(0) @binding(9) var<storage, read_write> moved: array<atomic<u32>>;
 @group(1) @binding(0) var<uniform> S: Step;
 
 // CPU twin: ON_SURFACE (m).
@@ -172,24 +178,21 @@ fn rigid_motion_at(x: vec3<f32>, k0: u32, k1: u32) -> vec3<f32> {
     return a1 - a0;
 }
 
-@compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= P.node_count || kind[i] != KIND_FREE) {
-        return;
-    }
+// Node i (free) projected out of the tool's path from its position at the step's start
+// (`prev`) to `pos` (unchanged where the tool misses it), with friction; marks the node
+// near the edge when within the cut reach of a cutting sphere.
+fn projected(i: u32) -> vec3<f32> {
     let k0 = S.substep;
     let k1 = S.substep + 1u;
     let rest = rest_pos[i].xyz;
-    let cur = pos[i];
     let x_prev = rest + prev[i].xyz;
-    let x_in = rest + cur.xyz;
+    let x_in = rest + pos[i].xyz;
     // Broad phase: the node's path against the tool's bounds (pose k0 and k1).
     let margin = max(P.reach, 0.0);
     let lo = min(tool[pose_base(k0) - 2u].xyz, tool[pose_base(k1) - 2u].xyz) - vec3<f32>(margin);
     let hi = max(tool[pose_base(k0) - 1u].xyz, tool[pose_base(k1) - 1u].xyz) + vec3<f32>(margin);
     if (any(max(x_prev, x_in) < lo) || any(min(x_prev, x_in) > hi)) {
-        return;
+        return x_in;
     }
     var p = x_in;
     let f0 = pose_base(k0);
@@ -218,11 +221,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
     }
-    if (any(p != x_in)) {
-        pos[i] = vec4<f32>(p - rest, cur.w);
-        // m Δx with m = 1 / w (free nodes have w > 0).
-        push[i] = vec4<f32>(push[i].xyz + (p - x_in) / cur.w, 0.0);
-    }
     if (P.reach >= 0.0) {
         var d = 3.4e38;
         for (var k = 0u; k < P.sphere_count; k = k + 1u) {
@@ -235,5 +233,74 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             near_edge[i] = 3u; // this frame and this release window (release.wgsl)
         }
     }
+    return p;
 }
 
+// The contact after a substep's tet constraints (or after an implicit step's solve): a
+// node the solve held comes back free (touched), every free node is projected, and one
+// it moved books its m Δx and is touched.
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= P.node_count) {
+        return;
+    }
+    if (kind[i] == KIND_HELD) {
+        kind[i] = KIND_FREE;
+        touch[i] = 1u;
+    }
+    if (kind[i] != KIND_FREE) {
+        return;
+    }
+    let cur = pos[i];
+    let x_in = rest_pos[i].xyz + cur.xyz;
+    let p = projected(i);
+    if (any(p != x_in)) {
+        pos[i] = vec4<f32>(p - rest_pos[i].xyz, cur.w);
+        // m Δx with m = 1 / w (free nodes have w > 0).
+        push[i] = vec4<f32>(push[i].xyz + (p - x_in) / cur.w, 0.0);
+        touch[i] = 1u;
+    }
+}
+
+// The blade before an implicit step's solve (CPU twin: Solver::hold_contacts): a node it
+// touched in the last step starts where it was, every free node is projected, and one it
+// moved is held through the solve.
+@compute @workgroup_size(64)
+fn hold(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= P.node_count) {
+        return;
+    }
+    let was = touch[i];
+    touch[i] = 0u;
+    if (kind[i] != KIND_FREE) {
+        return;
+    }
+    if (was != 0u) {
+        pos[i] = vec4<f32>(prev[i].xyz, pos[i].w);
+    }
+    let x_in = rest_pos[i].xyz + pos[i].xyz;
+    let p = projected(i);
+    if (any(p != x_in)) {
+        pos[i] = vec4<f32>(p - rest_pos[i].xyz, pos[i].w);
+        kind[i] = KIND_HELD;
+    }
+}
+
+// After an implicit step's solve: the free nodes it carried into the tool are projected
+// out and held too; `moved[0]` counts them (the host solves again if any).
+@compute @workgroup_size(64)
+fn resolve(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= P.node_count || kind[i] != KIND_FREE) {
+        return;
+    }
+    let x_in = rest_pos[i].xyz + pos[i].xyz;
+    let p = projected(i);
+    if (any(p != x_in)) {
+        pos[i] = vec4<f32>(p - rest_pos[i].xyz, pos[i].w);
+        kind[i] = KIND_HELD;
+        atomicAdd(&moved[0], 1u);
+    }
+}

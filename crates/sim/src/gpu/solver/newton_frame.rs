@@ -59,7 +59,15 @@ impl GpuSolver {
                 pass.set_bind_group(1, &self.bind.predict_steps[s], &[]);
                 pass.dispatch_workgroups(groups(nodes), 1, 1);
                 dispatches += 1;
+                if self.host.tool.is_some() {
+                    pass.set_pipeline(&self.kernels.contact_hold);
+                    pass.set_bind_group(0, &self.bind.contact_hold, &[]);
+                    pass.set_bind_group(1, &self.bind.hold_steps[s], &[]);
+                    pass.dispatch_workgroups(groups(nodes), 1, 1);
+                    dispatches += 1;
+                }
             }
+            newton.start_step(&mut enc);
             let live: Vec<bool> = (self.host.slot_of_tet.iter())
                 .map(|&slot| self.host.slots[slot as usize].live)
                 .collect();
@@ -70,7 +78,20 @@ impl GpuSolver {
                 read_pos: &self.read.pos,
             };
             enc = newton.solve_step(&dev, &live, enc)?;
-            let r = newton.last;
+            let mut r = newton.last;
+            if self.host.tool.is_some() {
+                dispatches += 1;
+                // The nodes the solve carried into the tool, held: solved again if any
+                // (CPU twin: the resolve pass of Solver::run_implicit_steps).
+                if self.record_resolve(enc, s)? > 0 {
+                    self.host.implicit_cost.add(&r);
+                    enc = newton.solve_step(&dev, &live, new_encoder(&self.device))?;
+                    r = newton.last;
+                } else {
+                    enc = new_encoder(&self.device);
+                }
+                newton.record_reaction(&mut enc);
+            }
             self.host.implicit_cost.add(&r);
             self.host.coarse_nodes = r.coarse_nodes;
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -103,4 +124,41 @@ impl GpuSolver {
         self.host.passes = dispatches;
         Ok(enc)
     }
+
+    /// Record the contact kernel's `resolve` for step `s` after `enc`, submit and read how
+    /// many nodes it held.
+    fn record_resolve(&self, mut enc: wgpu::CommandEncoder, s: usize) -> Result<u32, GpuError> {
+        enc.clear_buffer(&self.buf.moved, 0, None);
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("newton contact resolve"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.kernels.contact_resolve);
+            pass.set_bind_group(0, &self.bind.contact_resolve, &[]);
+            pass.set_bind_group(1, &self.bind.resolve_steps[s], &[]);
+            pass.dispatch_workgroups(groups(self.host.x.len()), 1, 1);
+        }
+        enc.copy_buffer_to_buffer(&self.buf.moved, 0, &self.read.moved, 0, 4);
+        self.queue.submit([enc.finish()]);
+        let slice = self.read.moved.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let view = slice
+            .get_mapped_range()
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        let count = bytemuck::cast_slice::<u8, u32>(&view)[0];
+        drop(view);
+        self.read.moved.unmap();
+        Ok(count)
+    }
+}
+
+/// A new command encoder for the rest of a Newton step.
+fn new_encoder(device: &wgpu::Device) -> wgpu::CommandEncoder {
+    device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("newton step"),
+    })
 }

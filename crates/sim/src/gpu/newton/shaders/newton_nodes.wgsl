@@ -12,6 +12,8 @@
 @group(0) @binding(4) var<storage, read> tet_out: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> inc: array<u32>;
 @group(0) @binding(6) var<storage, read_write> scratch: array<f32>;
+// The contact kernel's per-node push (contact.wgsl): `reaction` books the held nodes'.
+@group(0) @binding(7) var<storage, read_write> push: array<vec4<f32>>;
 
 fn is_free(i: u32) -> bool {
     return kind[i] == KIND_FREE;
@@ -34,6 +36,33 @@ fn start(@builtin(global_invocation_id) gid: vec3<u32>) {
         pos[i] = p;
     }
     vecs[vi(V_TRIAL, i)] = p;
+}
+
+// A further solve of the same step (the nodes the last one carried into the tool now
+// held): its first point is the iterate as the contact left it.
+@compute @workgroup_size(64)
+fn resume(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i < NW.node_count) {
+        vecs[vi(V_TRIAL, i)] = pos[i];
+    }
+}
+
+// The force that held each node the tool held through the solve, grad G there (CPU twin:
+// NewtonWorkspace::reaction), booked as the tool's push h^2 f (contact.wgsl's m dx).
+@compute @workgroup_size(64)
+fn reaction(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= NW.node_count || kind[i] != KIND_HELD) {
+        return;
+    }
+    let m = vecs[vi(V_MASS, i)].x * NW.inv_h2;
+    var g = (pos[i].xyz - vecs[vi(V_Y, i)].xyz) * m;
+    for (var k = inc[i]; k < inc[i + 1u]; k++) {
+        let e = inc[k];
+        g += tet_out[(e >> 2u) * TET_STRIDE + FORCE + (e & 3u)].xyz;
+    }
+    push[i] = vec4<f32>(push[i].xyz + g / NW.inv_h2, 0.0);
 }
 
 // grad G = M/h^2 (u - y) + sum of the corner forces, and the inverse of
