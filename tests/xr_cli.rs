@@ -205,6 +205,34 @@ fn simulated_headset_renders_both_eyes_and_the_controller_stroke_cuts() {
 }
 
 /// The same 2 mm deep stroke cuts with the trigger held and only pushes with it released.
+/// The default organ (`config/intestine_pull.ron`, the implicit scheme) in the headset: a
+/// trainee's scalpel pressed 3 mm into the bowel wall meets the tissue's force, and the
+/// controller vibrates. Before the implicit scheme held the blade's nodes through its
+/// solve, the force was about 2 mN and the controller never vibrated (threshold 0.05 N).
+#[test]
+fn the_default_organ_in_the_headset_pushes_back_on_the_scalpel() {
+    let script = "(display_hz: 72.0, duration: 0.8, eye_size: (64, 64), render_every: 1000, \
+        pacing: Nominal,\n head: [(t: 0.0, position: (0.0, 1.25, -0.05), \
+        orientation: (-0.34202, 0.0, 0.0, 0.93969))],\n right: Some(Tool(start: 0.1, \
+        stroke: Incision((start: (-0.05, 0.0, 0.03), end: (0.05, 0.0, 0.03), depth: 0.003, \
+        speed: 0.02, approach: 0.005)))),\n trigger: [(0.0, 1.0)])";
+    let (o, out) = run_xr(
+        "xr-default-scalpel",
+        script,
+        &["config/intestine_pull.ron", "--device", "cpu"],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let r = xr_report(&out, &o);
+    assert_eq!(r["exit"], "Exited", "{r}");
+    let force = r["max_tool_force"].as_f64().unwrap();
+    assert!(force > 0.3, "the bowel pushes back on the blade: {force} N");
+    let pulses = r["haptic_pulses"].as_u64().unwrap();
+    assert!(
+        pulses > 0 && r["max_haptic"].as_f64().unwrap() > 0.0,
+        "the controller vibrated: {r}"
+    );
+}
+
 #[test]
 fn with_the_trigger_released_the_blade_pushes_but_does_not_cut() {
     // Shallower than the other test's cut: a dull blade 5 mm deep inverts tets.
