@@ -232,11 +232,12 @@ fn a_pressing_blade_matches_the_cpu() {
     let Some(ctx) = common::gpu_context() else {
         return;
     };
-    let top = 0.012;
-    let r = 0.003;
-    let start = Vec3::new(0.011, 0.01, top + r + 0.001);
+    let start = Vec3::new(
+        0.011,
+        0.01,
+        common::PRESSED_TOP + common::PRESSED_BLADE_R + 0.001,
+    );
     let block = || {
-        let mesh = common::block_mesh(Vec3::ZERO, Vec3::new(0.04, 0.02, top), UVec3::new(8, 4, 3));
         let params = SolverParams {
             scheme: Scheme::Newton(NewtonParams {
                 steps: 2,
@@ -247,17 +248,7 @@ fn a_pressing_blade_matches_the_cpu() {
             threads: 1,
             ..SolverParams::default()
         };
-        let mut s = Solver::new(mesh, common::soft(10e3, 0.45), params).unwrap();
-        let bottom: Vec<u32> = (0..s.mesh().node_count() as u32)
-            .filter(|&i| s.mesh().rest_positions[i as usize].z < 1e-4)
-            .collect();
-        s.pin(&bottom);
-        s.set_tool(
-            common::blade(4, r, r),
-            ToolPose::new(start, glam::Quat::IDENTITY),
-        )
-        .unwrap();
-        s
+        common::pressed_block(params, start)
     };
     let mut cpu = block();
     let mut gpu = GpuSolver::new(block(), &ctx).expect("upload");

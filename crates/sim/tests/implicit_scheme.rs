@@ -463,11 +463,12 @@ fn prepare_builds_the_workspace_before_the_first_frame() {
 #[test]
 fn a_pressing_blade_meets_the_tissue_as_the_xpbd_reference_does() {
     use incise_sim::contact::ToolPose;
-    let top = 0.012;
-    let r = 0.003;
-    let start = Vec3::new(0.011, 0.01, top + r + 0.0002);
+    let start = Vec3::new(
+        0.011,
+        0.01,
+        common::PRESSED_TOP + common::PRESSED_BLADE_R + 0.0002,
+    );
     let block = |scheme: Scheme, substeps: u32| {
-        let mesh = common::block_mesh(Vec3::ZERO, Vec3::new(0.04, 0.02, top), UVec3::new(8, 4, 3));
         let params = SolverParams {
             scheme,
             substeps,
@@ -475,17 +476,7 @@ fn a_pressing_blade_meets_the_tissue_as_the_xpbd_reference_does() {
             damping: 10.0,
             ..SolverParams::default()
         };
-        let mut s = Solver::new(mesh, common::soft(10e3, 0.45), params).unwrap();
-        let bottom: Vec<u32> = (0..s.mesh().node_count() as u32)
-            .filter(|&i| s.mesh().rest_positions[i as usize].z < 1e-4)
-            .collect();
-        s.pin(&bottom);
-        s.set_tool(
-            common::blade(4, r, r),
-            ToolPose::new(start, glam::Quat::IDENTITY),
-        )
-        .unwrap();
-        s
+        common::pressed_block(params, start)
     };
     let mut newton = block(Scheme::Newton(NewtonParams::default()), 1);
     let mut xpbd = block(Scheme::Xpbd, 400);

@@ -1128,21 +1128,25 @@ fn contact_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu:
 
 /// The bind group of the contact kernel's `hold` (rebuilt with [`contact_group`]).
 fn hold_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu::BindGroup {
-    let list = [
-        (&b.params, 0),
-        (&b.pos, 1),
-        (&b.prev, 2),
-        (&b.kind, 3),
-        (&b.rest_pos, 4),
-        (&b.tool, 5),
-        (&b.near_edge, 7),
-        (&b.touch, 8),
-    ];
-    numbered_group(device, &kernels.contact_hold, "contact hold", &list)
+    let pipe = &kernels.contact_hold;
+    projection_group(device, pipe, "contact hold", b, (&b.touch, 8))
 }
 
 /// The bind group of the contact kernel's `resolve` (rebuilt with [`contact_group`]).
 fn resolve_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu::BindGroup {
+    let pipe = &kernels.contact_resolve;
+    projection_group(device, pipe, "contact resolve", b, (&b.moved, 9))
+}
+
+/// Group 0 of a contact entry point that projects without booking a push: what
+/// contact.wgsl's `projected` reads and writes, and its own `extra` binding.
+fn projection_group(
+    device: &wgpu::Device,
+    pipe: &wgpu::ComputePipeline,
+    label: &str,
+    b: &Buffers,
+    extra: (&wgpu::Buffer, u32),
+) -> wgpu::BindGroup {
     let list = [
         (&b.params, 0),
         (&b.pos, 1),
@@ -1151,9 +1155,9 @@ fn resolve_group(device: &wgpu::Device, kernels: &Kernels, b: &Buffers) -> wgpu:
         (&b.rest_pos, 4),
         (&b.tool, 5),
         (&b.near_edge, 7),
-        (&b.moved, 9),
+        extra,
     ];
-    numbered_group(device, &kernels.contact_resolve, "contact resolve", &list)
+    numbered_group(device, pipe, label, &list)
 }
 
 /// Group 0 of `pipe` from buffers with their binding numbers.

@@ -196,6 +196,33 @@ pub fn blade(count: usize, r: f32, spacing: f32) -> incise_sim::contact::Contact
     }
 }
 
+/// Top of the pressed block ([`pressed_block`]), m.
+pub const PRESSED_TOP: f32 = 0.012;
+/// Radius of the pressing blade's spheres, m.
+pub const PRESSED_BLADE_R: f32 = 0.003;
+
+/// A soft block (4 × 2 × 1.2 cm, 10 kPa, ν = 0.45) with its bottom pinned and a
+/// four-sphere [`blade`] placed at `blade_at`, on `params`: what a blade presses into.
+pub fn pressed_block(params: SolverParams, blade_at: Vec3) -> Solver {
+    let mesh = block_mesh(
+        Vec3::ZERO,
+        Vec3::new(0.04, 0.02, PRESSED_TOP),
+        UVec3::new(8, 4, 3),
+    );
+    let mut s = Solver::new(mesh, soft(10e3, 0.45), params).unwrap();
+    let bottom: Vec<u32> = (0..s.mesh().node_count() as u32)
+        .filter(|&i| s.mesh().rest_positions[i as usize].z < 1e-4)
+        .collect();
+    s.pin(&bottom);
+    let r = PRESSED_BLADE_R;
+    s.set_tool(
+        blade(4, r, r),
+        incise_sim::contact::ToolPose::new(blade_at, glam::Quat::IDENTITY),
+    )
+    .unwrap();
+    s
+}
+
 /// Top of the incision block, m.
 pub const INCISION_TOP: f32 = 0.02;
 /// Blade depth of the scripted incision below the top, m.
