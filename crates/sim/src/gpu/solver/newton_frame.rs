@@ -1,7 +1,9 @@
 //! A frame of the implicit scheme on the device: per implicit step the XPBD solver's
-//! prediction kernel, the Newton solve (`gpu/newton/`), then its contact, velocity and
-//! release-check kernels on the same simulation-time schedule. CPU twin:
-//! `Solver::run_implicit_steps` (crates/sim/src/xpbd/implicit_step.rs).
+//! prediction kernel, the blade's held nodes (the contact kernel's `hold`), the Newton
+//! solve (`gpu/newton/`; once more when `resolve` held the nodes it carried into the
+//! tool), the held nodes' reactions, then the contact, velocity and release-check kernels
+//! on the same simulation-time schedule. CPU twin: `Solver::run_implicit_steps`
+//! (crates/sim/src/xpbd/implicit_step.rs).
 
 use super::{GpuSolver, groups};
 use crate::gpu::GpuError;
