@@ -62,7 +62,7 @@ struct Buffers {
     tool: wgpu::Buffer,
     push: wgpu::Buffer,
     near_edge: wgpu::Buffer,
-    /// Nodes the tool held or pushed in the last implicit step (the host's `touched`).
+    /// Nodes the tool held through the last implicit step's solve (the host's `touched`).
     touch: wgpu::Buffer,
     /// How many nodes the contact kernel's `resolve` held (one counter).
     moved: wgpu::Buffer,

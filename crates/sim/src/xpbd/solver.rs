@@ -86,8 +86,8 @@ pub struct Solver {
     /// Per node, Σ m Δx of the contact projections this frame (tissue side), kg·m; under
     /// `scheme: Newton`, h² times the force that held a node in the blade's path.
     pub(crate) contact_push: Vec<Vec3>,
-    /// Nodes the tool held or pushed in the last implicit step (`scheme: Newton`): the
-    /// next step starts them where they were, in the blade's path.
+    /// Nodes the tool held through the last implicit step's solve (`scheme: Newton`): the
+    /// next step starts them where they were, on the blade.
     pub(crate) touched: Vec<bool>,
     pub(crate) frame: u64,
     pub(crate) time: f64,
@@ -610,7 +610,6 @@ impl Solver {
     pub(crate) fn project_contacts(&mut self, s: u32, n: u32) {
         for (i, pushed) in self.contacts(s, n) {
             self.contact_push[i] += self.mass[i] * pushed;
-            self.touched[i] = true;
         }
     }
 
@@ -646,7 +645,7 @@ impl Solver {
     }
 
     /// The blade in the implicit step `s` of `n` (`scheme: Newton`), before its solve: the
-    /// nodes it touched in the last step start where they were, every free node is
+    /// nodes it held in the last step start where they were, every free node is
     /// projected out of the tool's path, and those it moved are marked `held` (the solve
     /// keeps them fixed, so the tissue around them answers the push within the step).
     pub(crate) fn hold_contacts(&mut self, s: u32, n: u32, held: &mut [bool]) {

@@ -19,7 +19,7 @@
 @group(0) @binding(5) var<storage, read> tool: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> push: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read_write> near_edge: array<u32>;
-// Nodes the tool held or pushed in the last implicit step (CPU twin: Solver::touched).
+// Nodes the tool held through the last implicit step's solve (CPU twin: Solver::touched).
 @group(0) @binding(8) var<storage, read_write> touch: array<u32>;
 // Nodes `resolve` held (one counter).
 @group(0) @binding(9) var<storage, read_write> moved: array<atomic<u32>>;
@@ -237,8 +237,8 @@ fn projected(i: u32) -> vec3<f32> {
 }
 
 // The contact after a substep's tet constraints (or after an implicit step's solve): a
-// node the solve held comes back free (touched), every free node is projected, and one
-// it moved books its m Δx and is touched.
+// node the solve held comes back free (touched: the next step starts it on the blade),
+// every free node is projected, and one it moved books its m Δx.
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -259,12 +259,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         pos[i] = vec4<f32>(p - rest_pos[i].xyz, cur.w);
         // m Δx with m = 1 / w (free nodes have w > 0).
         push[i] = vec4<f32>(push[i].xyz + (p - x_in) / cur.w, 0.0);
-        touch[i] = 1u;
     }
 }
 
 // The blade before an implicit step's solve (CPU twin: Solver::hold_contacts): a node it
-// touched in the last step starts where it was, every free node is projected, and one it
+// held in the last step starts where it was, every free node is projected, and one it
 // moved is held through the solve.
 @compute @workgroup_size(64)
 fn hold(@builtin(global_invocation_id) gid: vec3<u32>) {
