@@ -238,11 +238,7 @@ impl NewtonWorkspace {
     /// the corner forces of its tets: after [`NewtonWorkspace::solve`] held the node fixed,
     /// the force whatever held it (the tool's blade) pushes it with, N.
     pub fn reaction(&self, u: &[Vec3], y: &[Vec3], node: usize) -> Vec3 {
-        let h = &self.hessian;
-        let inertia = (u[node] - y[node]) * (h.mass[node] * h.inv_h2);
-        h.incident(node).iter().fold(inertia, |g, &(t, a)| {
-            g + h.evals.force(t as usize, a as usize)
-        })
+        self.hessian.node_sums(u, y, node).0
     }
 
     /// Re-assemble the coarse matrix from the live tets' current tangents and refactorise
@@ -363,6 +359,19 @@ impl Hessian {
         elastic + 0.5 * self.inv_h2 as f64 * inertia
     }
 
+    /// `∂G/∂x` and the diagonal block of `∇²G` at node `i` from the tet evaluations in
+    /// hand: `m/h² (u − y)` and `m/h² I` plus its tets' corner forces and blocks.
+    fn node_sums(&self, u: &[Vec3], y: &[Vec3], i: usize) -> (Vec3, Mat3) {
+        let m = self.mass[i] * self.inv_h2;
+        let mut g = (u[i] - y[i]) * m;
+        let mut d = Mat3::IDENTITY * m;
+        for &(t, a) in self.incident(i) {
+            g += self.evals.force(t as usize, a as usize);
+            d += self.evals.diag(t as usize, a as usize);
+        }
+        (g, d)
+    }
+
     /// `∇G` and the inverted diagonal blocks of `∇²G` per node (zero at fixed nodes).
     fn gather_gradient(
         &self,
@@ -379,13 +388,7 @@ impl Hessian {
                 *out.1 = Mat3::ZERO;
                 return;
             }
-            let m = self.mass[i] * self.inv_h2;
-            let mut g = (u[i] - y[i]) * m;
-            let mut d = Mat3::IDENTITY * m;
-            for &(t, a) in self.incident(i) {
-                g += self.evals.force(t as usize, a as usize);
-                d += self.evals.diag(t as usize, a as usize);
-            }
+            let (g, d) = self.node_sums(u, y, i);
             *out.0 = g;
             *out.1 = d.inverse();
         };
