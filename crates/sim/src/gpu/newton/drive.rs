@@ -87,8 +87,9 @@ impl GpuNewton {
         self.dispatches += record(enc, &[(&self.kernels.reaction, &self.bind.nodes, ng)]);
     }
 
-    /// Minimise `G` from the iterate in `pos` (after [`GpuNewton::start_step`], or as a
-    /// further solve of the step left it); `enc` holds the commands recorded so far.
+    /// Minimise `G` from the iterate in `pos`: right after [`GpuNewton::start_step`]
+    /// (which set the point to evaluate), or, `again`, as a further solve of the step
+    /// left it and the contact moved it since; `enc` holds the commands recorded so far.
     /// `live` per tet (mesh order) is what a coarse refresh assembles. Returns an encoder
     /// to record the rest of the frame in.
     pub fn solve_step(
@@ -96,15 +97,17 @@ impl GpuNewton {
         dev: &OnDevice<'_>,
         live: &[bool],
         mut enc: wgpu::CommandEncoder,
+        again: bool,
     ) -> Result<wgpu::CommandEncoder, GpuError> {
         let mut report = NewtonReport::default();
         let refresh = self.coarse.refresh_due(&self.last);
         let (k, b) = (&self.kernels, &self.bind);
         let (ng, tg, _) = self.groups;
+        let resume = if again { ng } else { 0 };
         self.dispatches += record(
             &mut enc,
             &[
-                (&k.resume, &b.nodes, ng),
+                (&k.resume, &b.nodes, resume),
                 (&k.evaluate, &b.tets, tg),
                 (&k.gather, &b.nodes, ng),
             ],
