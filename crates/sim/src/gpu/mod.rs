@@ -9,6 +9,7 @@ mod device;
 mod kernels;
 mod layout;
 mod newton;
+mod readback;
 mod solver;
 
 pub use context::{DeviceFault, GpuContext, GpuError};

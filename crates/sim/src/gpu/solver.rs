@@ -16,6 +16,7 @@ use super::layout::{
     KIND_FREE, KIND_GRAB0, KIND_PINNED, KIND_RETIRED, Params, STEP_STRIDE, Step, TetRest,
 };
 use super::newton::{GpuNewton, Shared};
+use super::readback::read_mapped;
 use super::{GpuContext, GpuError};
 use crate::Solver;
 use crate::contact::{ContactTool, CutZone, PlacedTool, ToolPose};
@@ -884,30 +885,11 @@ impl GpuSolver {
         if let Some(ts) = &self.timestamps {
             bufs.push(&ts.read);
         }
-        for b in &bufs {
-            b.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        }
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let view = |b: &wgpu::Buffer| -> Result<Vec<u8>, GpuError> {
-            let v = b
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| GpuError::Readback(e.to_string()))?;
-            let out = v.to_vec();
-            drop(v);
-            b.unmap();
-            Ok(out)
-        };
-        let pos = view(&self.read.pos)?;
-        let vel = view(&self.read.vel)?;
-        let vm = view(&self.read.von_mises)?;
-        let det = view(&self.read.det_f)?;
-        let rel = view(&self.read.released)?;
+        let mut got = read_mapped::<u8>(&self.device, &bufs)?.into_iter();
+        let mut view = || got.next().unwrap_or_default();
+        let (pos, vel, vm, det, rel) = (view(), view(), view(), view(), view());
         if with_tool {
-            let push = view(&self.read.push)?;
-            let near = view(&self.read.near_edge)?;
+            let (push, near) = (view(), view());
             let push: &[[f32; 4]] = bytemuck::cast_slice(&push);
             let near: &[u32] = bytemuck::cast_slice(&near);
             for (i, (p, e)) in push.iter().zip(near).enumerate() {
@@ -922,7 +904,7 @@ impl GpuSolver {
             self.host.near_edge.iter_mut().for_each(|e| *e = false);
         }
         if let Some(ts) = &self.timestamps {
-            let t = view(&ts.read)?;
+            let t = view();
             let q: &[u64] = bytemuck::cast_slice(&t);
             self.last_timing = Some(GpuTiming {
                 frame_ms: q[1].wrapping_sub(q[0]) as f64 * ts.period_ns as f64 * 1e-6,
@@ -971,26 +953,11 @@ impl GpuSolver {
     }
 
     fn read_state_only(&mut self) -> Result<(), GpuError> {
-        for b in [&self.read.pos, &self.read.vel] {
-            b.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        }
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        for (b, dst) in [
-            (&self.read.pos, &mut self.host.u),
-            (&self.read.vel, &mut self.host.v),
-        ] {
-            let v = b
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| GpuError::Readback(e.to_string()))?;
-            let a: &[[f32; 4]] = bytemuck::cast_slice(&v);
+        let got = read_mapped::<[f32; 4]>(&self.device, &[&self.read.pos, &self.read.vel])?;
+        for (a, dst) in got.iter().zip([&mut self.host.u, &mut self.host.v]) {
             for (d, p) in dst.iter_mut().zip(a) {
                 *d = Vec3::new(p[0], p[1], p[2]);
             }
-            drop(v);
-            b.unmap();
         }
         Ok(())
     }

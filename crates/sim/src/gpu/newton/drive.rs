@@ -11,6 +11,7 @@ use glam::Vec3;
 use super::GpuNewton;
 use super::layout::{ALPHA_OFFSET, S_FIRST, S_NEG, S_PRODUCTS, S_STOP, V_TRIAL};
 use crate::gpu::GpuError;
+use crate::gpu::readback::read_mapped;
 use crate::implicit::NewtonReport;
 
 /// Armijo constant of the line search (the CPU's).
@@ -294,31 +295,15 @@ impl GpuNewton {
             enc.copy_buffer_to_buffer(dev.pos, 0, dev.read_pos, 0, pos_bytes);
         }
         dev.queue.submit([enc.finish()]);
-        let read = |b: &wgpu::Buffer| b.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        read(&self.buf.read_scratch);
+        let mut bufs = vec![&self.buf.read_scratch];
         if positions {
-            read(dev.read_pos);
+            bufs.push(dev.read_pos);
         }
-        dev.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let view = |b: &wgpu::Buffer| -> Result<Vec<f32>, GpuError> {
-            let v = b
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| GpuError::Readback(e.to_string()))?;
-            let out = bytemuck::cast_slice(&v).to_vec();
-            drop(v);
-            b.unmap();
-            Ok(out)
-        };
-        let scratch = view(&self.buf.read_scratch)?;
-        let u = if positions {
-            let p = view(dev.read_pos)?;
-            Some(p.chunks(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect())
-        } else {
-            None
-        };
+        let mut got = read_mapped::<f32>(dev.device, &bufs)?.into_iter();
+        let scratch = got.next().unwrap_or_default();
+        let u = got
+            .next()
+            .map(|p| p.chunks(4).map(|c| Vec3::new(c[0], c[1], c[2])).collect());
         Ok((scratch, u))
     }
 }

@@ -8,6 +8,7 @@
 use super::{GpuSolver, groups};
 use crate::gpu::GpuError;
 use crate::gpu::newton::OnDevice;
+use crate::gpu::readback::read_mapped;
 use crate::xpbd::release_checks;
 
 impl GpuSolver {
@@ -143,17 +144,8 @@ impl GpuSolver {
         }
         enc.copy_buffer_to_buffer(&self.buf.moved, 0, &self.read.moved, 0, 4);
         self.queue.submit([enc.finish()]);
-        let slice = self.read.moved.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let view = slice
-            .get_mapped_range()
-            .map_err(|e| GpuError::Readback(e.to_string()))?;
-        let count = bytemuck::cast_slice::<u8, u32>(&view)[0];
-        drop(view);
-        self.read.moved.unmap();
+        let got = read_mapped::<u32>(&self.device, &[&self.read.moved])?;
+        let count = got[0][0];
         Ok(count)
     }
 }
