@@ -38,6 +38,9 @@ pub struct FrameCost {
     pub halvings: u32,
     /// Steps that re-assembled the coarse matrix.
     pub coarse_refreshes: u32,
+    /// Steps under the blade taken back and redone in two halves (more live tets inverted
+    /// after them than before).
+    pub split_steps: u32,
 }
 
 impl FrameCost {

@@ -146,6 +146,14 @@ impl NewtonWorkspace {
         self.pre.level.release(tets)
     }
 
+    /// Solve the next steps at step length `h` (a step redone in halves under the blade,
+    /// docs/physics-notes.md "The implicit scheme under a blade"): the inertia term
+    /// changes now; the coarse level keeps the one it was factorised with until its next
+    /// refresh, which only slows the conjugate gradient.
+    pub fn set_step_length(&mut self, h: f32) {
+        self.hessian.inv_h2 = 1.0 / (h * h);
+    }
+
     /// Minimise `G` from `u` (which holds the initial guess, `y` at free nodes and the
     /// targets at fixed ones); `live` per tet (mesh order), `free` per node.
     pub fn solve(

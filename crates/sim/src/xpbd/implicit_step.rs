@@ -6,6 +6,7 @@
 //! the release checks on the same simulation-time schedule (PHYSICS.md §1.4), so stress,
 //! release and contact are those of the XPBD scheme.
 
+use super::neo_hookean::deformation_gradient_from_displacement;
 use super::release_schedule::release_checks;
 use super::solver::{NodeKind, Solver};
 use super::{CpuKernel, SolverError};
@@ -17,6 +18,10 @@ use crate::implicit::{NewtonParams, NewtonWorkspace, Scheme};
 /// (docs/physics-notes.md, "The implicit scheme under a blade": one pass more brings the
 /// released tets to the reference's on plate_cut; a second costs more and gains nothing).
 const CONTACT_RESOLVES: usize = 1;
+
+/// How many times a step under the blade may be halved (`Solver::implicit_piece`): a
+/// step becomes at most 2^3 = 8 steps.
+const MAX_SPLITS: u32 = 3;
 
 impl Solver {
     /// Build the implicit scheme's workspace (coarse grid, its factorised matrix) now, if
@@ -62,52 +67,107 @@ impl Solver {
         self.passes = checks.len() as u32;
         self.implicit_cost = Default::default();
         for s in 0..n {
-            let t = self.time + (s + 1) as f64 * h as f64;
-            self.predict(h, t);
-            // PHYSICS.md §1.5 inside the step (docs/physics-notes.md, "The implicit scheme
-            // under a blade"): the nodes in the tool's path are held where it pushes them.
-            let mut held = vec![false; free.len()];
-            self.hold_contacts(s, n, &mut held);
-            // A held node's target is where the tool holds it.
-            let y = self.u.clone();
-            // Start from u + h v without this step's gravity: y itself drops every free
-            // node by h²g (2.7 mm at 60 Hz, a tet's height) while the pins hold, which
-            // crushes the tets along the pins in the first iterate.
-            let fall = self.params.gravity * (h * h);
-            for (i, u) in self.u.iter_mut().enumerate() {
-                if free[i] && !held[i] {
-                    *u -= fall;
-                }
-            }
-            let live: Vec<bool> = self
-                .slot_of_tet
-                .iter()
-                .map(|&slot| self.slots[slot as usize].live)
-                .collect();
-            for pass in 0..=CONTACT_RESOLVES {
-                let step_free: Vec<bool> = free.iter().zip(&held).map(|(f, h)| *f && !*h).collect();
-                self.implicit_solve(&y, &live, &step_free, parallel);
-                if pass == CONTACT_RESOLVES {
-                    break;
-                }
-                // Nodes the solve carried into the tool: held too, and solved again.
-                let moved = self.contacts(s, n);
-                if moved.is_empty() {
-                    break;
-                }
-                for (i, _) in moved {
-                    held[i] = true;
-                }
-            }
-            self.push_held(h, &y, &held);
-            self.project_contacts(s, n);
-            self.update_velocities(h);
+            self.implicit_piece((s, n), &free, parallel, 0);
             fresh = next.next_if(|&&k| k == s).is_some();
             if fresh {
                 self.release_check(parallel);
             }
         }
         Ok(fresh)
+    }
+
+    /// Step `s` of `n` of the frame (its time and the tool's motion over it). Under the
+    /// blade, a step after which more live tets are inverted than before it is taken
+    /// back and redone as two half steps, up to `MAX_SPLITS` deep (docs/physics-notes.md,
+    /// "The implicit scheme under a blade").
+    fn implicit_piece(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool, depth: u32) {
+        let start = (depth < MAX_SPLITS && self.tool.is_some()).then(|| {
+            (
+                self.u.clone(),
+                self.v.clone(),
+                self.touched.clone(),
+                self.contact_push.clone(),
+            )
+        });
+        let before = if start.is_some() {
+            self.inverted_live_tets()
+        } else {
+            0
+        };
+        let held = self.implicit_step((s, n), free, parallel);
+        let Some((u, v, touched, push)) = start else {
+            return;
+        };
+        if !held || self.inverted_live_tets() <= before {
+            return;
+        }
+        (self.u, self.v, self.touched, self.contact_push) = (u, v, touched, push);
+        self.implicit_cost.split_steps += 1;
+        self.implicit_piece((2 * s, 2 * n), free, parallel, depth + 1);
+        self.implicit_piece((2 * s + 1, 2 * n), free, parallel, depth + 1);
+    }
+
+    /// One implicit Euler step, `s` of `n` in the frame: prediction, the nodes in the
+    /// tool's path held, the solve (again with the nodes it carried into the tool), the
+    /// held nodes' reactions, contact and velocities. Returns whether the tool held a node.
+    fn implicit_step(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool) -> bool {
+        let h = self.params.frame_dt / n as f32;
+        if let Some(ws) = &mut self.newton {
+            ws.set_step_length(h);
+        }
+        let t = self.time + (s + 1) as f64 * h as f64;
+        self.predict(h, t);
+        // PHYSICS.md §1.5 inside the step (docs/physics-notes.md, "The implicit scheme
+        // under a blade"): the nodes in the tool's path are held where it pushes them.
+        let mut held = vec![false; free.len()];
+        self.hold_contacts(s, n, &mut held);
+        // A held node's target is where the tool holds it.
+        let y = self.u.clone();
+        // Start from u + h v without this step's gravity: y itself drops every free
+        // node by h²g (2.7 mm at 60 Hz, a tet's height) while the pins hold, which
+        // crushes the tets along the pins in the first iterate.
+        let fall = self.params.gravity * (h * h);
+        for (i, u) in self.u.iter_mut().enumerate() {
+            if free[i] && !held[i] {
+                *u -= fall;
+            }
+        }
+        let live: Vec<bool> = self
+            .slot_of_tet
+            .iter()
+            .map(|&slot| self.slots[slot as usize].live)
+            .collect();
+        for pass in 0..=CONTACT_RESOLVES {
+            let step_free: Vec<bool> = free.iter().zip(&held).map(|(f, h)| *f && !*h).collect();
+            self.implicit_solve(&y, &live, &step_free, parallel);
+            if pass == CONTACT_RESOLVES {
+                break;
+            }
+            // Nodes the solve carried into the tool: held too, and solved again.
+            let moved = self.contacts(s, n);
+            if moved.is_empty() {
+                break;
+            }
+            for (i, _) in moved {
+                held[i] = true;
+            }
+        }
+        self.push_held(h, &y, &held);
+        self.project_contacts(s, n);
+        self.update_velocities(h);
+        held.contains(&true)
+    }
+
+    /// Live tets whose volume ratio `J` is at most 0 where the nodes stand now.
+    fn inverted_live_tets(&self) -> usize {
+        (0..self.mesh.tet_count())
+            .filter(|&t| self.slots[self.slot_of_tet[t] as usize].live)
+            .filter(|&t| {
+                let d = self.mesh.tets[t].map(|k| self.u[k as usize]);
+                deformation_gradient_from_displacement(&d, &self.mesh.dm_inv[t]).determinant()
+                    <= 0.0
+            })
+            .count()
     }
 
     /// One Newton solve of the step from `u` to the minimum of `G` (target `y`), the nodes

@@ -919,6 +919,7 @@ impl Solver {
             negative_curvature: self.implicit_cost.negative_curvature,
             line_search_halvings: self.implicit_cost.halvings,
             coarse_refreshes: self.implicit_cost.coarse_refreshes,
+            split_steps: self.implicit_cost.split_steps,
             coarse_nodes: self.coarse_nodes,
         }
     }
