@@ -312,3 +312,63 @@ fn rest_stays_exactly_at_rest_on_the_gpu() {
     let moved = common::max_displacement(g.host());
     assert_eq!(moved, 0.0, "moved {moved} m");
 }
+
+/// A blade plunged 5 mm into the block in one frame inverts tets under the nodes it
+/// holds; the frame is taken back and run at two steps, on the device as on the CPU
+/// (Solver::run_implicit_steps; docs/physics-notes.md, "The implicit scheme under a
+/// blade"), and the two agree on the result.
+#[test]
+fn a_plunging_blade_takes_the_frame_again_as_the_cpu_does() {
+    use incise_sim::contact::ToolPose;
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
+    let start = Vec3::new(
+        0.011,
+        0.01,
+        common::PRESSED_TOP + common::PRESSED_BLADE_R + 0.001,
+    );
+    let block = || {
+        let params = SolverParams {
+            scheme: Scheme::Newton(NewtonParams::default()),
+            gravity: Vec3::ZERO,
+            damping: 10.0,
+            threads: 1,
+            ..SolverParams::default()
+        };
+        common::pressed_block(params, start)
+    };
+    let mut cpu = block();
+    let mut gpu = GpuSolver::new(block(), &ctx).expect("upload");
+    let pose = ToolPose::new(start - Vec3::Z * 0.006, glam::Quat::IDENTITY);
+    cpu.move_tool(pose);
+    gpu.move_tool(pose);
+    let a = cpu.step_frame().unwrap();
+    let b = gpu.step_frame().unwrap();
+    assert_eq!(
+        (a.split_frames, b.split_frames),
+        (1, 1),
+        "the frame ran again at two steps on both"
+    );
+    let inverted = |s: &Solver| s.det_f().iter().filter(|&&j| j <= 0.0).count();
+    assert_eq!(inverted(&cpu), 0, "no tet left inverted on the CPU");
+    assert_eq!(
+        inverted(gpu.host()),
+        0,
+        "no tet left inverted on the device"
+    );
+    let dent = common::max_displacement(&cpu);
+    let gap = common::worst_gap(cpu.positions(), gpu.host().positions());
+    assert!(dent > 0.004, "the blade dents the block: {dent} m");
+    assert!(
+        gap <= WHOLE * dent,
+        "positions {gap:e} m apart at a dent of {dent:e} m"
+    );
+    let df = (a.tool_force - b.tool_force).length();
+    assert!(
+        df <= 1e-2 * a.tool_force.length(),
+        "tool force {} N on the CPU, {} N on the device",
+        a.tool_force,
+        b.tool_force
+    );
+}

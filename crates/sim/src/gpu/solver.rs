@@ -20,9 +20,11 @@ use super::readback::read_mapped;
 use super::{GpuContext, GpuError};
 use crate::Solver;
 use crate::contact::{ContactTool, CutZone, PlacedTool, ToolPose};
+use crate::implicit::Scheme;
 use crate::stress::StressMeasure;
 use crate::xpbd::{
-    ConstraintPair, CpuSweep, FrameStats, NodeKind, SolverError, TetProjection, release_checks,
+    ConstraintPair, CpuSweep, FrameStats, MAX_SPLITS, NodeKind, SolverError, SolverParams,
+    TetProjection, release_checks,
 };
 
 const WG: u32 = 64;
@@ -59,6 +61,9 @@ struct Buffers {
     released_list: wgpu::Buffer,
     saved_pos: wgpu::Buffer,
     saved_vel: wgpu::Buffer,
+    /// `touch` and `near_edge` at the frame's start (a frame taken back restores them).
+    saved_touch: wgpu::Buffer,
+    saved_near_edge: wgpu::Buffer,
     rest_pos: wgpu::Buffer,
     tool: wgpu::Buffer,
     push: wgpu::Buffer,
@@ -235,9 +240,10 @@ impl GpuSolver {
             .map(|&t| host.rotation[t as usize].to_array())
             .collect();
         let p = &host.params;
-        let params = params_of(&host);
-        // Step records: one per substep or implicit step (prediction), then one per colour.
-        let substeps = p.steps() as usize;
+        let params = params_of(&host, p.steps());
+        // Step records: one per substep or implicit step (prediction; under the implicit
+        // scheme for a frame run at up to 2^MAX_SPLITS times its steps), then one per colour.
+        let substeps = step_records(p);
         let colours = host.color_ranges.len();
         let phases = host.plan.phases.len();
         let mut step_bytes = vec![0u8; (substeps + colours + phases) * STEP_STRIDE as usize];
@@ -351,6 +357,8 @@ impl GpuSolver {
             tool: storage(&device, "tool", &[0u8; 16], none),
             push: storage(&device, "contact push", &vec![0u8; n * 16], none),
             near_edge: storage(&device, "near edge", &vec![0u8; n * 4], none),
+            saved_near_edge: storage(&device, "saved near edge", &vec![0u8; n * 4], none),
+            saved_touch: storage(&device, "saved touched", &vec![0u8; n * 4], none),
             touch: storage(
                 &device,
                 "touched",
@@ -625,69 +633,35 @@ impl GpuSolver {
     pub fn step_frame(&mut self) -> Result<FrameStats, SolverError> {
         let t0 = Instant::now();
         self.check_device()?;
-        self.upload_grab_offsets();
-        self.upload_tool();
-        let mut enc = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("frame"),
-            });
-        let (n, slots) = (self.host.x.len() as u64, self.host.slots.len() as u64);
-        enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.buf.saved_pos, 0, n * 16);
-        enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.buf.saved_vel, 0, n * 16);
-        enc.copy_buffer_to_buffer(&self.buf.live, 0, &self.buf.saved_live, 0, slots * 4);
-        enc.clear_buffer(&self.buf.released_count, 0, None);
-        let with_tool = self.host.tool.is_some();
-        if with_tool {
-            enc.clear_buffer(&self.buf.push, 0, None);
-        }
-
-        let mut enc = if self.newton.is_some() {
-            self.record_newton_frame(enc)
-                .map_err(|e| SolverError::Device(e.to_string()))?
+        let steps = self.host.params.steps();
+        // The implicit scheme under a blade: a frame that leaves more live tets inverted
+        // is taken back and run at twice the steps (CPU twin: Solver::run_implicit_steps).
+        let split = self.newton.is_some() && self.host.tool.is_some();
+        let inverted = if split {
+            self.host.inverted_live_tets(&[])
         } else {
-            self.host.passes = self.record_frame(&mut enc);
-            enc
+            0
         };
-        if with_tool {
-            enc.copy_buffer_to_buffer(&self.buf.push, 0, &self.read.push, 0, n * 16);
-            enc.copy_buffer_to_buffer(&self.buf.near_edge, 0, &self.read.near_edge, 0, n * 4);
-        }
-        enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.read.pos, 0, n * 16);
-        enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.read.vel, 0, n * 16);
-        enc.copy_buffer_to_buffer(&self.buf.von_mises, 0, &self.read.von_mises, 0, slots * 4);
-        enc.copy_buffer_to_buffer(&self.buf.det_f, 0, &self.read.det_f, 0, slots * 4);
-        enc.copy_buffer_to_buffer(&self.buf.released_count, 0, &self.read.released, 0, 4);
-        enc.copy_buffer_to_buffer(
-            &self.buf.released_list,
-            0,
-            &self.read.released,
-            4,
-            slots * 4,
-        );
-        if let Some(ts) = &self.timestamps {
-            enc.resolve_query_set(&ts.queries, 0..2, &ts.resolve, 0);
-            enc.copy_buffer_to_buffer(&ts.resolve, 0, &ts.read, 0, 16);
-        }
-        self.queue.submit([enc.finish()]);
-        // The last good state, kept until the device has said the frame went well (a lost
-        // device can map buffers of zeros).
-        let good = (self.host.u.clone(), self.host.v.clone());
-        let read = self
-            .read_back()
-            .map_err(|e| SolverError::Device(e.to_string()));
-        let released = match (read, self.fault.get()) {
-            (Ok(r), None) => r,
-            (read, fault) => {
-                (self.host.u, self.host.v) = good;
-                self.host.sync_positions();
-                return Err(match (fault, read) {
-                    (Some(msg), _) => SolverError::Device(msg),
-                    (None, Err(e)) => e,
-                    (None, Ok(_)) => unreachable!("handled above"),
-                });
+        self.host.implicit_cost = Default::default();
+        let (mut n, mut passes) = (steps, 0);
+        let released = loop {
+            let released = self.run_frame(n)?;
+            passes += self.host.passes;
+            if !split || n >= steps << MAX_SPLITS {
+                break released;
             }
+            let gone: Vec<u32> = released
+                .iter()
+                .map(|&s| self.host.tet_of_slot[s as usize])
+                .collect();
+            if self.host.inverted_live_tets(&gone) <= inverted {
+                break released;
+            }
+            self.restore_saved();
+            self.host.implicit_cost.split_frames += 1;
+            n *= 2;
         };
+        self.host.passes = passes;
         // Device work ends when the readback completes: that is the frame's solve time.
         let t1 = Instant::now();
         let solve_ms = (t1 - t0).as_secs_f64() * 1e3;
@@ -719,13 +693,94 @@ impl GpuSolver {
         Ok(stats)
     }
 
-    fn upload_grab_offsets(&mut self) {
+    /// One attempt at the frame in `n` steps: upload, record, submit and read back into
+    /// the host mirror; returns the slots released. A device fault restores the host's
+    /// last good state.
+    fn run_frame(&mut self, n: u32) -> Result<Vec<u32>, SolverError> {
+        if let Some(newton) = &mut self.newton {
+            newton.set_step_length(&self.queue, self.host.params.frame_dt / n as f32);
+        }
+        self.upload_grab_offsets(n);
+        self.upload_tool(n);
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
+        let (nodes, slots) = (self.host.x.len() as u64, self.host.slots.len() as u64);
+        enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.buf.saved_pos, 0, nodes * 16);
+        enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.buf.saved_vel, 0, nodes * 16);
+        enc.copy_buffer_to_buffer(&self.buf.live, 0, &self.buf.saved_live, 0, slots * 4);
+        enc.clear_buffer(&self.buf.released_count, 0, None);
+        let with_tool = self.host.tool.is_some();
+        if with_tool {
+            enc.copy_buffer_to_buffer(&self.buf.touch, 0, &self.buf.saved_touch, 0, nodes * 4);
+            enc.copy_buffer_to_buffer(
+                &self.buf.near_edge,
+                0,
+                &self.buf.saved_near_edge,
+                0,
+                nodes * 4,
+            );
+            enc.clear_buffer(&self.buf.push, 0, None);
+        }
+
+        let mut enc = if self.newton.is_some() {
+            self.record_newton_frame(enc, n)
+                .map_err(|e| SolverError::Device(e.to_string()))?
+        } else {
+            self.host.passes = self.record_frame(&mut enc);
+            enc
+        };
+        if with_tool {
+            enc.copy_buffer_to_buffer(&self.buf.push, 0, &self.read.push, 0, nodes * 16);
+            enc.copy_buffer_to_buffer(&self.buf.near_edge, 0, &self.read.near_edge, 0, nodes * 4);
+        }
+        enc.copy_buffer_to_buffer(&self.buf.pos, 0, &self.read.pos, 0, nodes * 16);
+        enc.copy_buffer_to_buffer(&self.buf.vel, 0, &self.read.vel, 0, nodes * 16);
+        enc.copy_buffer_to_buffer(&self.buf.von_mises, 0, &self.read.von_mises, 0, slots * 4);
+        enc.copy_buffer_to_buffer(&self.buf.det_f, 0, &self.read.det_f, 0, slots * 4);
+        enc.copy_buffer_to_buffer(&self.buf.released_count, 0, &self.read.released, 0, 4);
+        enc.copy_buffer_to_buffer(
+            &self.buf.released_list,
+            0,
+            &self.read.released,
+            4,
+            slots * 4,
+        );
+        if let Some(ts) = &self.timestamps {
+            enc.resolve_query_set(&ts.queries, 0..2, &ts.resolve, 0);
+            enc.copy_buffer_to_buffer(&ts.resolve, 0, &ts.read, 0, 16);
+        }
+        self.queue.submit([enc.finish()]);
+        // The last good state, kept until the device has said the frame went well (a lost
+        // device can map buffers of zeros).
+        let good = (self.host.u.clone(), self.host.v.clone());
+        let read = self
+            .read_back()
+            .map_err(|e| SolverError::Device(e.to_string()));
+        match (read, self.fault.get()) {
+            (Ok(r), None) => Ok(r),
+            (read, fault) => {
+                (self.host.u, self.host.v) = good;
+                self.host.sync_positions();
+                Err(match (fault, read) {
+                    (Some(msg), _) => SolverError::Device(msg),
+                    (None, Err(e)) => e,
+                    (None, Ok(_)) => unreachable!("handled above"),
+                })
+            }
+        }
+    }
+
+    /// Grab offsets at the ends of the frame's `n` steps.
+    fn upload_grab_offsets(&mut self, n: u32) {
         let grabs = &self.host.grabs;
         if grabs.is_empty() {
             return;
         }
-        let h = self.host.params.step_length() as f64;
-        for s in 0..self.host.params.steps() as usize {
+        let h = (self.host.params.frame_dt / n as f32) as f64;
+        for s in 0..n as usize {
             let t = self.host.time + (s + 1) as f64 * h;
             for (g, grab) in grabs.iter().enumerate() {
                 let o = grab.offset_at(t);
@@ -739,12 +794,11 @@ impl GpuSolver {
         );
     }
 
-    /// Parameters, primitive poses for every substep boundary and, when the tool's
-    /// primitive count changed, a larger tool buffer.
-    fn upload_tool(&mut self) {
-        let params = params_of(&self.host);
+    /// Parameters, primitive poses for every boundary of the frame's `n` steps and, when
+    /// the tool's primitive count changed, a larger tool buffer.
+    fn upload_tool(&mut self, n: u32) {
+        let params = params_of(&self.host, n);
         if let Some(motion) = &self.host.tool {
-            let n = self.host.params.steps();
             self.tool_words.clear();
             for k in 0..=n {
                 push_placed(&mut self.tool_words, &motion.placed_at(k, n));
@@ -932,8 +986,16 @@ impl GpuSolver {
         Ok(released)
     }
 
-    /// Restore the frame's starting positions and velocities on both sides.
+    /// Restore the frame's starting positions and velocities on both sides, and its
+    /// clock.
     fn roll_back(&mut self) {
+        self.restore_saved();
+        self.host.time -= self.host.params.frame_dt as f64;
+    }
+
+    /// Restore the frame's starting state on both sides: positions, velocities, live
+    /// tets and, with a tool, the nodes on the blade and the near-edge flags.
+    fn restore_saved(&mut self) {
         let n = self.host.x.len() as u64;
         let mut enc = self
             .device
@@ -942,6 +1004,10 @@ impl GpuSolver {
             });
         enc.copy_buffer_to_buffer(&self.buf.saved_pos, 0, &self.buf.pos, 0, n * 16);
         enc.copy_buffer_to_buffer(&self.buf.saved_vel, 0, &self.buf.vel, 0, n * 16);
+        if self.host.tool.is_some() {
+            enc.copy_buffer_to_buffer(&self.buf.saved_touch, 0, &self.buf.touch, 0, n * 4);
+            enc.copy_buffer_to_buffer(&self.buf.saved_near_edge, 0, &self.buf.near_edge, 0, n * 4);
+        }
         let slots = self.host.slots.len() as u64;
         enc.copy_buffer_to_buffer(&self.buf.saved_live, 0, &self.buf.live, 0, slots * 4);
         enc.copy_buffer_to_buffer(&self.buf.saved_pos, 0, &self.read.pos, 0, n * 16);
@@ -949,7 +1015,6 @@ impl GpuSolver {
         self.queue.submit([enc.finish()]);
         let _ = self.read_state_only();
         self.host.sync_positions();
-        self.host.time -= self.host.params.frame_dt as f64;
     }
 
     fn read_state_only(&mut self) -> Result<(), GpuError> {
@@ -980,10 +1045,10 @@ impl GpuSolver {
 }
 
 /// The kernels' `Params` for the host's settings and tool (primitive counts and friction
-/// of the attached tool, if any).
-fn params_of(host: &Solver) -> Params {
+/// of the attached tool, if any), the frame in `steps` steps.
+fn params_of(host: &Solver, steps: u32) -> Params {
     let p = &host.params;
-    let h = p.step_length();
+    let h = p.frame_dt / steps as f32;
     let (sphere_count, box_count, friction) = host.tool.as_ref().map_or((0, 0, 0.0), |m| {
         (
             m.tool.spheres.len() as u32,
@@ -1022,6 +1087,15 @@ fn params_of(host: &Solver) -> Params {
             StressMeasure::Cauchy => 0,
             StressMeasure::PaperEq3 => 1,
         },
+    }
+}
+
+/// Step records a frame may use: its substeps under XPBD; under the implicit scheme its
+/// steps at up to `MAX_SPLITS` doublings (`Solver::run_implicit_steps`).
+fn step_records(p: &SolverParams) -> usize {
+    match p.scheme {
+        Scheme::Newton(_) => (p.steps() << MAX_SPLITS) as usize,
+        Scheme::Xpbd => p.steps() as usize,
     }
 }
 

@@ -38,9 +38,9 @@ pub struct FrameCost {
     pub halvings: u32,
     /// Steps that re-assembled the coarse matrix.
     pub coarse_refreshes: u32,
-    /// Steps under the blade taken back and redone in two halves (more live tets inverted
-    /// after them than before).
-    pub split_steps: u32,
+    /// Times the frame under the blade was taken back and run again at twice the steps
+    /// (more live tets inverted after it than before).
+    pub split_frames: u32,
 }
 
 impl FrameCost {

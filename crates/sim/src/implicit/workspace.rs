@@ -146,10 +146,10 @@ impl NewtonWorkspace {
         self.pre.level.release(tets)
     }
 
-    /// Solve the next steps at step length `h` (a step redone in halves under the blade,
-    /// docs/physics-notes.md "The implicit scheme under a blade"): the inertia term
-    /// changes now; the coarse level keeps the one it was factorised with until its next
-    /// refresh, which only slows the conjugate gradient.
+    /// Solve the next steps at step length `h` (a frame run again at more steps under
+    /// the blade, docs/physics-notes.md "The implicit scheme under a blade"): the inertia
+    /// term changes; the coarse level keeps the scene's own step's (it only
+    /// preconditions), as on the device.
     pub fn set_step_length(&mut self, h: f32) {
         self.hessian.inv_h2 = 1.0 / (h * h);
     }

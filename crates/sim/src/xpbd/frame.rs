@@ -52,9 +52,9 @@ pub struct FrameStats {
     pub line_search_halvings: u32,
     /// Implicit steps of the frame that re-assembled the coarse matrix (0 under XPBD).
     pub coarse_refreshes: u32,
-    /// Implicit steps under the blade redone in two halves because they left more live
-    /// tets inverted than they found (0 under XPBD and without a tool).
-    pub split_steps: u32,
+    /// Times the frame was run again at twice the implicit steps because it left more
+    /// live tets inverted than it found (a tool attached; 0 under XPBD).
+    pub split_frames: u32,
     /// Coarse nodes of the implicit scheme's preconditioner at the frame's end (0 under
     /// XPBD): more than the whole body's once a cut has split the grid.
     pub coarse_nodes: u32,

@@ -19,9 +19,41 @@ use crate::implicit::{NewtonParams, NewtonWorkspace, Scheme};
 /// released tets to the reference's on plate_cut; a second costs more and gains nothing).
 const CONTACT_RESOLVES: usize = 1;
 
-/// How many times a step under the blade may be halved (`Solver::implicit_piece`): a
-/// step becomes at most 2^3 = 8 steps.
-const MAX_SPLITS: u32 = 3;
+/// How many times a frame under the blade may be run again at twice the steps
+/// (`Solver::run_implicit_steps`): at most 2^3 = 8 times the scene's steps.
+pub const MAX_SPLITS: u32 = 3;
+
+/// What a frame under the blade starts from, to take it back.
+struct FrameStart {
+    u: Vec<Vec3>,
+    v: Vec<Vec3>,
+    touched: Vec<bool>,
+    near_window: Vec<bool>,
+    inverted: usize,
+}
+
+impl FrameStart {
+    fn of(s: &Solver) -> Self {
+        FrameStart {
+            u: s.u.clone(),
+            v: s.v.clone(),
+            touched: s.touched.clone(),
+            near_window: s.near_window.clone(),
+            inverted: s.inverted_live_tets(&[]),
+        }
+    }
+
+    /// Back to the frame's start: the tets its release checks switched off live again.
+    fn restore(&self, s: &mut Solver) {
+        s.u.clone_from(&self.u);
+        s.v.clone_from(&self.v);
+        s.touched.clone_from(&self.touched);
+        s.near_window.clone_from(&self.near_window);
+        s.near_edge.iter_mut().for_each(|b| *b = false);
+        s.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
+        s.revive_pending();
+    }
+}
 
 impl Solver {
     /// Build the implicit scheme's workspace (coarse grid, its factorised matrix) now, if
@@ -50,71 +82,61 @@ impl Solver {
     }
 
     /// The frame's implicit steps; returns whether a release check ran after the last one
-    /// (the stress is then current).
+    /// (the stress is then current). With a tool attached, a frame after which more live
+    /// tets are inverted than before it is taken back (positions, velocities, the nodes
+    /// on the blade, the push, its releases) and run again at twice the steps, up to
+    /// `MAX_SPLITS` times (docs/physics-notes.md, "The implicit scheme under a blade").
     pub(crate) fn run_implicit_steps(
         &mut self,
         p: NewtonParams,
         parallel: bool,
     ) -> Result<bool, SolverError> {
-        let n = p.steps;
-        let h = self.params.frame_dt / n as f32;
         self.prepare_implicit(p)?;
+        self.implicit_cost = Default::default();
+        self.check_ms = 0.0;
+        self.passes = 0;
+        let start = self.tool.is_some().then(|| FrameStart::of(self));
+        let mut n = p.steps;
+        loop {
+            let fresh = self.implicit_steps(n, parallel);
+            let Some(start) = &start else {
+                return Ok(fresh);
+            };
+            if n >= p.steps << MAX_SPLITS || self.inverted_live_tets(&[]) <= start.inverted {
+                return Ok(fresh);
+            }
+            start.restore(self);
+            self.implicit_cost.split_frames += 1;
+            n *= 2;
+        }
+    }
+
+    /// `n` implicit steps over the frame with the release checks that fall in them.
+    fn implicit_steps(&mut self, n: u32, parallel: bool) -> bool {
+        let h = self.params.frame_dt / n as f32;
+        if let Some(ws) = &mut self.newton {
+            ws.set_step_length(h);
+        }
         let free: Vec<bool> = self.kind.iter().map(|k| *k == NodeKind::Free).collect();
         let checks = release_checks(self.time, h, n, self.params.release_interval);
         let mut next = checks.iter().peekable();
         let mut fresh = false;
-        self.check_ms = 0.0;
-        self.passes = checks.len() as u32;
-        self.implicit_cost = Default::default();
+        self.passes += checks.len() as u32;
         for s in 0..n {
-            self.implicit_piece((s, n), &free, parallel, 0);
+            self.implicit_step((s, n), &free, parallel);
             fresh = next.next_if(|&&k| k == s).is_some();
             if fresh {
                 self.release_check(parallel);
             }
         }
-        Ok(fresh)
-    }
-
-    /// Step `s` of `n` of the frame (its time and the tool's motion over it). Under the
-    /// blade, a step after which more live tets are inverted than before it is taken
-    /// back and redone as two half steps, up to `MAX_SPLITS` deep (docs/physics-notes.md,
-    /// "The implicit scheme under a blade").
-    fn implicit_piece(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool, depth: u32) {
-        let start = (depth < MAX_SPLITS && self.tool.is_some()).then(|| {
-            (
-                self.u.clone(),
-                self.v.clone(),
-                self.touched.clone(),
-                self.contact_push.clone(),
-            )
-        });
-        let before = if start.is_some() {
-            self.inverted_live_tets()
-        } else {
-            0
-        };
-        let held = self.implicit_step((s, n), free, parallel);
-        let Some((u, v, touched, push)) = start else {
-            return;
-        };
-        if !held || self.inverted_live_tets() <= before {
-            return;
-        }
-        (self.u, self.v, self.touched, self.contact_push) = (u, v, touched, push);
-        self.implicit_cost.split_steps += 1;
-        self.implicit_piece((2 * s, 2 * n), free, parallel, depth + 1);
-        self.implicit_piece((2 * s + 1, 2 * n), free, parallel, depth + 1);
+        fresh
     }
 
     /// One implicit Euler step, `s` of `n` in the frame: prediction, the nodes in the
     /// tool's path held, the solve (again with the nodes it carried into the tool), the
-    /// held nodes' reactions, contact and velocities. Returns whether the tool held a node.
-    fn implicit_step(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool) -> bool {
+    /// held nodes' reactions, contact and velocities.
+    fn implicit_step(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool) {
         let h = self.params.frame_dt / n as f32;
-        if let Some(ws) = &mut self.newton {
-            ws.set_step_length(h);
-        }
         let t = self.time + (s + 1) as f64 * h as f64;
         self.predict(h, t);
         // PHYSICS.md §1.5 inside the step (docs/physics-notes.md, "The implicit scheme
@@ -155,13 +177,19 @@ impl Solver {
         self.push_held(h, &y, &held);
         self.project_contacts(s, n);
         self.update_velocities(h);
-        held.contains(&true)
     }
 
-    /// Live tets whose volume ratio `J` is at most 0 where the nodes stand now.
-    fn inverted_live_tets(&self) -> usize {
+    /// Live tets whose volume ratio `J` is at most 0 where the nodes stand now, leaving
+    /// out `gone` (tets released but not yet switched off in this mirror: the device's).
+    pub(crate) fn inverted_live_tets(&self, gone: &[u32]) -> usize {
+        let mut live: Vec<bool> = (self.slot_of_tet.iter())
+            .map(|&slot| self.slots[slot as usize].live)
+            .collect();
+        for &t in gone {
+            live[t as usize] = false;
+        }
         (0..self.mesh.tet_count())
-            .filter(|&t| self.slots[self.slot_of_tet[t] as usize].live)
+            .filter(|&t| live[t])
             .filter(|&t| {
                 let d = self.mesh.tets[t].map(|k| self.u[k as usize]);
                 deformation_gradient_from_displacement(&d, &self.mesh.dm_inv[t]).determinant()

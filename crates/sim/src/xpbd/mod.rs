@@ -29,6 +29,7 @@ mod tet_slot;
 pub use coloring::greedy_tet_colors;
 pub use flop_count::{LN_FLOPS, NODE_FLOPS_PER_SUBSTEP, projection_flops};
 pub use frame::FrameStats;
+pub use implicit_step::MAX_SPLITS;
 pub use locality::TetOrder;
 pub use neo_hookean::{
     ConstraintPair, TetProjection, TetTerms, deformation_gradient, det_gradient,

@@ -544,7 +544,7 @@ impl Solver {
     }
 
     /// Switch the tets of a rolled-back frame's release checks back on.
-    fn revive_pending(&mut self) {
+    pub(crate) fn revive_pending(&mut self) {
         for t in std::mem::take(&mut self.pending) {
             self.set_live(t, true);
         }
@@ -919,7 +919,7 @@ impl Solver {
             negative_curvature: self.implicit_cost.negative_curvature,
             line_search_halvings: self.implicit_cost.halvings,
             coarse_refreshes: self.implicit_cost.coarse_refreshes,
-            split_steps: self.implicit_cost.split_steps,
+            split_frames: self.implicit_cost.split_frames,
             coarse_nodes: self.coarse_nodes,
         }
     }

@@ -26,6 +26,11 @@ pub(crate) struct NewtonUniform {
 /// Byte offset of `alpha` in [`NewtonUniform`] (the line search writes it per trial).
 pub(crate) const ALPHA_OFFSET: u64 = 44;
 
+/// Byte offsets of `inv_h2` and `fall` in [`NewtonUniform`] (written when a frame runs
+/// at other steps).
+pub(crate) const INV_H2_OFFSET: u64 = 16;
+pub(crate) const FALL_OFFSET: u64 = 32;
+
 /// Byte offset of `coarse_nodes` in [`NewtonUniform`] (written when a cut rebuilds the
 /// coarse grid).
 pub(crate) const COARSE_NODES_OFFSET: u64 = 8;
@@ -117,6 +122,14 @@ mod tests {
         assert_eq!(
             std::mem::offset_of!(NewtonUniform, coarse_nodes) as u64,
             COARSE_NODES_OFFSET
+        );
+        assert_eq!(
+            std::mem::offset_of!(NewtonUniform, inv_h2) as u64,
+            INV_H2_OFFSET
+        );
+        assert_eq!(
+            std::mem::offset_of!(NewtonUniform, fall) as u64,
+            FALL_OFFSET
         );
         let src = include_str!("shaders/newton_common.wgsl");
         for (name, value) in [

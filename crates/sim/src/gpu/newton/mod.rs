@@ -21,7 +21,10 @@ use crate::implicit::{NewtonParams, NewtonReport, Scheme, Smoother};
 use crate::xpbd::{NodeKind, Solver};
 use coarse::HostCoarse;
 use kernels::NewtonKernels;
-use layout::{COARSE_NODES_OFFSET, GROUP, NewtonUniform, Scratch, TET_STRIDE, V_MASS, V_SLICES};
+use layout::{
+    COARSE_NODES_OFFSET, FALL_OFFSET, GROUP, INV_H2_OFFSET, NewtonUniform, Scratch, TET_STRIDE,
+    V_MASS, V_SLICES,
+};
 
 /// The XPBD solver's device buffers the Newton kernels read and write too.
 pub(crate) struct Shared<'a> {
@@ -76,6 +79,8 @@ pub(crate) struct GpuNewton {
     /// Workgroups of a node, a tet and a coarse-row dispatch.
     groups: (u32, u32, u32),
     inv_h2: f32,
+    /// Gravity, for the starting point's fall at another step length.
+    gravity: glam::Vec3,
     /// The mesh's mean rest edge, m (the step stop's unit).
     mean_edge: f32,
     node_count: usize,
@@ -293,6 +298,7 @@ impl GpuNewton {
             coarse,
             scratch,
             inv_h2,
+            gravity: host.params.gravity,
             mean_edge: mesh.mean_edge_length(),
             node_count: n,
             last: NewtonReport::default(),
@@ -301,6 +307,25 @@ impl GpuNewton {
             generation: 0,
         };
         Ok(Some(newton))
+    }
+
+    /// Solve the next steps at step length `h` (a frame run again at more steps under the
+    /// blade): the inertia and the starting point's fall change; the coarse level keeps
+    /// the scene's own step's inertia (it only preconditions), as on the CPU
+    /// (`NewtonWorkspace::set_step_length`).
+    pub fn set_step_length(&mut self, queue: &wgpu::Queue, h: f32) {
+        let inv_h2 = 1.0 / (h * h);
+        if inv_h2 == self.inv_h2 {
+            return;
+        }
+        self.inv_h2 = inv_h2;
+        queue.write_buffer(
+            &self.buf.uniform,
+            INV_H2_OFFSET,
+            bytemuck::bytes_of(&inv_h2),
+        );
+        let fall = (self.gravity * (h * h)).to_array();
+        queue.write_buffer(&self.buf.uniform, FALL_OFFSET, bytemuck::cast_slice(&fall));
     }
 
     /// Take released tets (mesh indices) out of the coarse level and upload its new

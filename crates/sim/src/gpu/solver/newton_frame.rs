@@ -19,31 +19,32 @@ impl GpuSolver {
     pub(super) fn record_newton_frame(
         &mut self,
         enc: wgpu::CommandEncoder,
+        n: u32,
     ) -> Result<wgpu::CommandEncoder, GpuError> {
         let Some(mut newton) = self.newton.take() else {
             return Ok(enc);
         };
         newton.dispatches = 0;
-        let done = self.newton_steps(&mut newton, enc);
+        let done = self.newton_steps(&mut newton, enc, n);
         self.host.passes += newton.dispatches;
         self.newton = Some(newton);
         done
     }
 
-    /// The steps of [`GpuSolver::record_newton_frame`]; its own dispatches go to the host's
-    /// pass count, the Newton solver's to `newton.dispatches`.
+    /// The `n` steps of [`GpuSolver::record_newton_frame`]; its own dispatches go to the
+    /// host's pass count, the Newton solver's to `newton.dispatches`.
     fn newton_steps(
         &mut self,
         newton: &mut crate::gpu::newton::GpuNewton,
         mut enc: wgpu::CommandEncoder,
+        n: u32,
     ) -> Result<wgpu::CommandEncoder, GpuError> {
         let p = &self.host.params;
-        let (h, n) = (p.step_length(), p.steps());
+        let h = p.frame_dt / n as f32;
         let checks = release_checks(self.host.time, h, n, p.release_interval);
         let nodes = self.host.x.len();
         let mut fresh = false;
         let mut dispatches = 0;
-        self.host.implicit_cost = Default::default();
         for s in 0..n as usize {
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
