@@ -667,14 +667,14 @@ fn run_three_frames(scene: &Path, out: &Path) -> std::process::Output {
 }
 
 /// A shipped scene copied into a folder of its own runs (issue 34, item 2): its material or
-/// rheology presets come from the built-in copies of config/'s preset files when none lies
-/// beside it, and the report says which file was read; a preset file beside the scene
-/// wins. A preset file that is neither there nor shipped is an error that names it and
+/// rheology presets, and its scalpel's tool file, come from the built-in copies of
+/// config/'s files when none lies beside it, and the report says which preset file was
+/// read; a file beside the scene wins. A preset file that is neither there nor shipped is an error that names it and
 /// the OS's cause once.
 #[test]
 fn a_scene_copied_anywhere_runs_with_the_built_in_presets() {
     let dir = temp_dir("scene-anywhere");
-    for name in ["plate_stretch.ron", "organ_layers.ron"] {
+    for name in ["plate_stretch.ron", "organ_layers.ron", "plate_cut.ron"] {
         let scene = dir.join(name);
         std::fs::copy(Path::new("config").join(name), &scene).unwrap();
         let o = run_three_frames(&scene, &dir.join(format!("out-{name}")));

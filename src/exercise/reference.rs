@@ -8,7 +8,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use glam::{DVec3, Mat3, Quat, Vec3};
-use incise_scalpel::{PoseKey, Stroke, load_tool};
+use incise_scalpel::{PoseKey, Stroke};
 
 use super::load::LoadedExercise;
 use super::reference_blade::blade_reference;
@@ -93,8 +93,7 @@ pub fn reference_stroke(ex: &LoadedExercise, style: ReferenceStyle) -> Result<St
         .tool
         .as_ref()
         .context("the exercise's scene has no tool")?;
-    let scene_dir = ex.scene_path.parent().unwrap_or(Path::new("."));
-    let tool = load_tool(&scene_dir.join(&spec.file))?;
+    let tool = crate::scene::load_tool_beside(&ex.scene_path, &spec.file)?;
     let depth = ex.exercise.depth as f64;
     let tilt0 = (style.tilt_deg as f64).to_radians();
     let tilt1 = FINISH_TILT_DEG.to_radians().max(tilt0);

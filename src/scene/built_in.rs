@@ -102,30 +102,22 @@ pub const FILES: &[(&str, &str)] = &[
     ),
 ];
 
-/// The shipped `config/materials.ron`.
-pub const MATERIALS: &str = include_str!("../../config/materials.ron");
-
-/// The shipped `config/rheology.ron`.
-pub const RHEOLOGY: &str = include_str!("../../config/rheology.ron");
-
-/// The text of the preset file `name` of a scene in `dir`, and the path that names it in
-/// errors and reports: the file beside the scene when there is one, else the built-in copy
-/// of a shipped preset file (`built-in config/NAME`), else the read error of the file
-/// beside the scene.
-pub fn preset_text(dir: &Path, name: &str) -> Result<(PathBuf, String), ReadError> {
+/// The text of the file `name` (relative to a scene's folder `dir`: a preset file, a
+/// tool, a stroke) and the path that names it in errors and reports: the file there when
+/// there is one, else the built-in copy of the shipped `config/NAME` (`built-in
+/// config/NAME`), else the read error of the file there.
+pub fn config_text(dir: &Path, name: &str) -> Result<(PathBuf, String), ReadError> {
     let beside = dir.join(name);
     if beside.exists() {
         return Ok((beside.clone(), ron_file::read(&beside)?));
     }
-    let built_in = match name {
-        "materials.ron" => MATERIALS,
-        "rheology.ron" => RHEOLOGY,
-        _ => return Err(ron_file::read(&beside).expect_err("the file does not exist")),
-    };
-    Ok((
-        PathBuf::from(format!("built-in config/{name}")),
-        built_in.to_string(),
-    ))
+    match FILES.iter().find(|(shipped, _)| *shipped == name) {
+        Some((shipped, text)) => Ok((
+            PathBuf::from(format!("built-in config/{shipped}")),
+            text.to_string(),
+        )),
+        None => Err(ron_file::read(&beside).expect_err("the file does not exist")),
+    }
 }
 
 /// The built-in scenes and exercises: (name, path under config/, first comment line), in

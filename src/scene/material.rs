@@ -6,7 +6,7 @@ use std::path::Path;
 use anyhow::{Result, anyhow};
 use incise_sim::Material;
 
-use super::built_in::preset_text;
+use super::built_in::config_text;
 use super::{MaterialChoice, Scene, parse_materials};
 
 /// The material of `scene` (read from `scene_path`) and its name ("custom" for values
@@ -19,7 +19,7 @@ pub fn scene_material(scene: &Scene, scene_path: &Path) -> Result<(Material, Str
         }
         MaterialChoice::Custom(m) => (*m, "custom".to_string()),
         MaterialChoice::Preset(name) => {
-            let (file, text) = preset_text(dir, "materials.ron")?;
+            let (file, text) = config_text(dir, "materials.ron")?;
             let presets = parse_materials(&text, &file)?;
             let m = presets.get(name).ok_or_else(|| {
                 anyhow!(

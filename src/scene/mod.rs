@@ -21,7 +21,7 @@ pub use model::{
     HoldSpec, IndenterSpec, MassSpringScene, ModelChoice, RegionSelect, RegionSpec, RheologyScene,
     StrokeSpec,
 };
-pub use tool::ToolSpec;
+pub use tool::{ToolSpec, load_tool_beside};
 
 use glam::{UVec3, Vec3};
 use incise_sim::Material;

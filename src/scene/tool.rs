@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use incise_scalpel::{Stroke, Tool, ToolStroke, load_stroke, load_tool};
+use incise_scalpel::{Stroke, Tool, ToolStroke, parse_stroke, parse_tool};
 use serde::Deserialize;
 
 /// The scalpel of a scene: a tool file, relative to the scene file.
@@ -17,17 +17,29 @@ pub struct ToolSpec {
     pub dull: bool,
 }
 
-/// Load the tool and build the stroke of a scene.
+/// Load the tool and build the stroke of a scene: files beside the scene, or the built-in
+/// copies of config/'s (`built_in::config_text`) for a scene copied out of config/.
 pub fn load(tool: &ToolSpec, stroke: &ToolStroke, scene_path: &Path) -> Result<(Tool, Stroke)> {
-    let dir = scene_path.parent().unwrap_or(Path::new("."));
-    let t = load_tool(&dir.join(&tool.file))
+    let t = load_tool_beside(scene_path, &tool.file)
         .with_context(|| format!("{}: tool", scene_path.display()))?;
     let s = match stroke {
-        ToolStroke::File(f) => load_stroke(&dir.join(f))
-            .with_context(|| format!("{}: stroke", scene_path.display()))?,
+        ToolStroke::File(f) => {
+            let dir = scene_path.parent().unwrap_or(Path::new("."));
+            let (path, text) = super::built_in::config_text(dir, f)
+                .with_context(|| format!("{}: stroke", scene_path.display()))?;
+            parse_stroke(&text, &path)
+                .with_context(|| format!("{}: stroke", scene_path.display()))?
+        }
         ToolStroke::Incision(i) => i
             .stroke(&t)
             .with_context(|| format!("{}: stroke.Incision", scene_path.display()))?,
     };
     Ok((t, s))
+}
+
+/// The tool file `file` of the scene at `scene_path`: beside it, or config/'s built-in copy.
+pub fn load_tool_beside(scene_path: &Path, file: &str) -> Result<Tool> {
+    let dir = scene_path.parent().unwrap_or(Path::new("."));
+    let (path, text) = super::built_in::config_text(dir, file)?;
+    Ok(parse_tool(&text, &path)?)
 }

@@ -29,7 +29,7 @@ pub fn open(
     let (raw, _) = raw_mesh(&scene.mesh, dir)?;
     let (mesh, mesh_report) =
         TetMesh::from_raw(raw).with_context(|| format!("{}: mesh", path.display()))?;
-    let (presets_path, presets) = crate::scene::built_in::preset_text(dir, &rh.presets)
+    let (presets_path, presets) = crate::scene::built_in::config_text(dir, &rh.presets)
         .map_err(anyhow::Error::from)
         .and_then(|(file, text)| Ok((file.clone(), RheologyPresets::parse(&text, &file)?)))
         .with_context(|| format!("{}: model.presets", path.display()))?;
