@@ -39,7 +39,8 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 
 /// Parse and validate scene text; `path` names it in errors.
 pub fn parse_scene(text: &str, path: &Path) -> Result<Scene, SceneError> {
-    let scene: Scene = ron_file::parse(text, path)?;
+    let mut scene: Scene = ron_file::parse(text, path)?;
+    super::default_scheme::apply(&mut scene, text, path)?;
     let value_err = |field: &str, msg: String| SceneError::Value {
         path: path.into(),
         line: locate(text, field),

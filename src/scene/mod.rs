@@ -3,6 +3,7 @@
 
 mod build;
 pub mod built_in;
+mod default_scheme;
 pub mod hand_tool;
 mod load;
 mod localisation;
@@ -13,6 +14,7 @@ mod tool;
 
 pub use build::raw_mesh;
 pub use build::{BuiltScene, SceneTool, ToolDriver, build_scene, build_scene_driven};
+pub use default_scheme::default_scheme;
 pub use load::{SceneError, load_materials, load_scene, locate, parse_materials, parse_scene};
 pub use localisation::Localisation;
 pub use material::scene_material;
@@ -52,7 +54,8 @@ pub struct Scene {
     /// Scripted grabs that pull node sets along paths.
     #[serde(default)]
     pub grabs: Vec<GrabSpec>,
-    /// Solver settings (dt, substeps, gravity, damping …).
+    /// Solver settings (scheme, dt, substeps, gravity, damping …); an Xpbd-model scene
+    /// whose file names no `scheme` runs `Newton(())` (`default_scheme`).
     #[serde(default)]
     pub solver: SolverParams,
     /// Stress-based cutting; absent = no cutting.

@@ -616,7 +616,17 @@ mod tests {
 
     #[test]
     fn fewer_substeps_keep_the_state_and_the_tool() {
-        let mut b = hand_plate();
+        // XPBD's substeps: the shipped scene names no scheme and runs the implicit one.
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut.ron");
+        let mut scene = crate::scene::load_scene(&path).unwrap();
+        scene.solver.scheme = incise_sim::implicit::Scheme::Xpbd;
+        let opts = OpenOptions {
+            device: DeviceChoice::Cpu,
+            hand: true,
+            quiet: true,
+            ..OpenOptions::default()
+        };
+        let mut b = open(&scene, &path, &opts).unwrap().0;
         let s = b.substeps().unwrap();
         assert!(s.fewest >= 1 && s.fewest < s.nominal, "{s:?}");
         let pose = ToolPose {
