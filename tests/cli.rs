@@ -258,14 +258,7 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
     // plate_cut on XPBD, the scheme whose sweep the JSON's figures describe (the shipped
     // scene names none and runs the implicit scheme; its tool comes from the built-in
     // config/ tree).
-    let dir = temp_dir("bench-realtime-xpbd");
-    let xpbd = dir.join("plate_cut.ron");
-    let text_of = std::fs::read_to_string("config/plate_cut.ron").unwrap();
-    std::fs::write(
-        &xpbd,
-        text_of.replace("    solver: (", "    solver: (scheme: Xpbd,"),
-    )
-    .unwrap();
+    let xpbd = common::scene_on_scheme("plate_cut.ron", "Xpbd", "bench-realtime-xpbd");
     let o = incise(&[
         "bench",
         "realtime",

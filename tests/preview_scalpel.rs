@@ -89,10 +89,29 @@ fn mouse_stroke(
     (body, hand, peak_force)
 }
 
+/// The stroke on plate_cut, which runs the implicit scheme (it names none). Sinking the
+/// blade 30 frames in one place stresses the slab until a burst of releases; before a
+/// frame that left more tets inverted was run again at twice the steps, the one-step
+/// frames with the blade's nodes held then inverted tets the solve could not right, and
+/// from frame 55 the slab blew up (3 kN on the blade by frame 63, 8,000 tets inverted, the
+/// run stopped at frame 88). Now at most a few tets invert for a frame, as on XPBD (one),
+/// and the blade's force stays that of cutting tissue.
 #[test]
 fn a_mouse_stroke_cuts_records_and_replays_the_same_tets() {
     let path = Path::new("config/plate_cut.ron");
-    let (body, mut hand, peak_force) = mouse_stroke(path, |_| {});
+    let mut worst = (0, f32::MAX);
+    let (body, mut hand, peak_force) = mouse_stroke(path, |body| {
+        let (n, lo) = inverted(body);
+        worst = (worst.0.max(n), worst.1.min(lo));
+    });
+    eprintln!(
+        "at most {} tets inverted in a frame, least J {:.3}",
+        worst.0, worst.1
+    );
+    assert!(worst.0 <= 5, "{} tets inverted in one frame", worst.0);
+    assert!(worst.1 > -1.0, "a tet reached J = {}", worst.1);
+    // 1.8 N at most (XPBD: 0.47 N); the haptic curve saturates at 4 N.
+    assert!(peak_force < 4.0, "{peak_force} N on the blade");
     let frames = body.frames();
     assert_eq!(frames, 90);
     assert!(
@@ -105,8 +124,9 @@ fn a_mouse_stroke_cuts_records_and_replays_the_same_tets() {
         "mouse stroke: {} tets released, peak tool force {peak_force:.3} N",
         cut.len()
     );
+    // XPBD's count for this stroke is 432.
     assert!(
-        cut.len() > 20,
+        (300..=600).contains(&cut.len()),
         "the mouse stroke released {} tets",
         cut.len()
     );
@@ -157,46 +177,4 @@ fn inverted(body: &RecordedBody) -> (usize, f32) {
         .fold((0, f32::MAX), |(n, lo), j| {
             (n + usize::from(j <= 0.0), lo.min(j))
         })
-}
-
-/// The same mouse stroke on the implicit scheme (the default scene's). Sinking the blade
-/// 30 frames in one place stresses the slab until a burst of releases; a one-step-a-frame
-/// solve with the blade's nodes held then inverted tets it could not right, and from frame
-/// 55 the slab blew up (3 kN on the blade by frame 63, 8,000 tets inverted). A frame after
-/// which more tets are inverted is now run again at twice the steps: at most a few tets
-/// invert for a frame, as on XPBD, and the blade's force stays that of cutting tissue.
-#[test]
-fn a_mouse_stroke_on_the_implicit_scheme_keeps_the_slab_whole() {
-    let dir = temp_dir("preview-scalpel-newton");
-    let text = std::fs::read_to_string("config/plate_cut.ron").unwrap();
-    let text = text.replace(
-        "    solver: (",
-        "    solver: (\n        scheme: Newton(()),",
-    );
-    assert!(text.contains("scheme: Newton"));
-    let scene = dir.join("plate_cut_newton.ron");
-    std::fs::write(&scene, text).unwrap();
-    std::fs::create_dir_all(dir.join("tools")).unwrap();
-    std::fs::copy(
-        "config/tools/scalpel_10.ron",
-        dir.join("tools/scalpel_10.ron"),
-    )
-    .unwrap();
-    let mut worst = (0, f32::MAX);
-    let (body, _, peak_force) = mouse_stroke(&scene, |body| {
-        let (n, lo) = inverted(body);
-        worst = (worst.0.max(n), worst.1.min(lo));
-    });
-    let cut = released(&body).len();
-    eprintln!(
-        "implicit scheme, mouse stroke: {cut} released, peak force {peak_force:.3} N, \
-         at most {} tets inverted in a frame, least J {:.3}",
-        worst.0, worst.1
-    );
-    assert!(worst.0 <= 5, "{} tets inverted in one frame", worst.0);
-    assert!(worst.1 > -1.0, "a tet reached J = {}", worst.1);
-    // 1.8 N at most (XPBD: 0.47 N); the haptic curve saturates at 4 N.
-    assert!(peak_force < 4.0, "{peak_force} N on the blade");
-    // XPBD's count for this stroke is 432.
-    assert!((300..=600).contains(&cut), "{cut} released");
 }

@@ -46,13 +46,7 @@ fn soak(device: &str) {
     // resident memory after one cut swings ±30 % from cut to cut with no trend (a 60 s
     // soak: 13-22 MB over 18 cuts, +4.6 % by the soak's own median rule), so three cuts
     // cannot tell a leak from it; docs/physics-notes.md, "Which scheme a scene runs".
-    let scene = temp_dir(&format!("soak-{device}-scene")).join("plate_cut_xpbd.ron");
-    let text_of = std::fs::read_to_string("config/plate_cut.ron").unwrap();
-    std::fs::write(
-        &scene,
-        text_of.replace("    solver: (", "    solver: (scheme: Xpbd,"),
-    )
-    .unwrap();
+    let scene = common::scene_on_scheme("plate_cut.ron", "Xpbd", &format!("soak-{device}-scene"));
     let (o, report) = run_soak(
         scene.to_str().unwrap(),
         &seconds,

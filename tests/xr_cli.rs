@@ -586,16 +586,7 @@ fn run_realtime(name: &str, args: &[&str]) -> (std::process::Output, std::path::
     // plate_cut on XPBD: these runs time the session's threads against a slowed solver,
     // and were set on XPBD's frame (on the implicit scheme, which the shipped scene runs,
     // the in-frame run's last frames outlast the script's end: 144 refreshes shown).
-    let dir = temp_dir(&format!("{name}-scene"));
-    let scene = dir.join("plate_cut.ron");
-    let text_of =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut.ron"))
-            .unwrap();
-    std::fs::write(
-        &scene,
-        text_of.replace("    solver: (", "    solver: (scheme: Xpbd,"),
-    )
-    .unwrap();
+    let scene = common::scene_on_scheme("plate_cut.ron", "Xpbd", &format!("{name}-scene"));
     let mut all = vec![scene.to_str().unwrap()];
     all.extend_from_slice(args);
     run_xr(name, &script, &all)

@@ -571,8 +571,14 @@ mod tests {
 
     /// The scene at `file` (from the repository root) opened for a hand.
     fn hand_body(file: &str) -> XpbdBody {
+        hand_body_with(file, |_| {})
+    }
+
+    /// The scene at `file`, changed by `edit`, opened for a hand.
+    fn hand_body_with(file: &str, edit: impl FnOnce(&mut crate::scene::Scene)) -> XpbdBody {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
-        let scene = crate::scene::load_scene(&path).unwrap();
+        let mut scene = crate::scene::load_scene(&path).unwrap();
+        edit(&mut scene);
         let opts = OpenOptions {
             device: DeviceChoice::Cpu,
             hand: true,
@@ -617,16 +623,9 @@ mod tests {
     #[test]
     fn fewer_substeps_keep_the_state_and_the_tool() {
         // XPBD's substeps: the shipped scene names no scheme and runs the implicit one.
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/plate_cut.ron");
-        let mut scene = crate::scene::load_scene(&path).unwrap();
-        scene.solver.scheme = incise_sim::implicit::Scheme::Xpbd;
-        let opts = OpenOptions {
-            device: DeviceChoice::Cpu,
-            hand: true,
-            quiet: true,
-            ..OpenOptions::default()
-        };
-        let mut b = open(&scene, &path, &opts).unwrap().0;
+        let mut b = hand_body_with("config/plate_cut.ron", |s| {
+            s.solver.scheme = incise_sim::implicit::Scheme::Xpbd
+        });
         let s = b.substeps().unwrap();
         assert!(s.fewest >= 1 && s.fewest < s.nominal, "{s:?}");
         let pose = ToolPose {

@@ -29,6 +29,23 @@ pub fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
+/// A copy of the shipped `config/NAME` in the scratch folder `folder` (see [`temp_dir`])
+/// with `scheme` (RON: `Xpbd`, `Newton(())`) named first in its solver; the tool and
+/// preset files it names come from the built-in config/ tree.
+pub fn scene_on_scheme(name: &str, scheme: &str, folder: &str) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("config");
+    let text = std::fs::read_to_string(root.join(name)).expect("a shipped scene");
+    let key = "    solver: (";
+    assert!(text.contains(key), "{name} has no solver");
+    let path = temp_dir(folder).join(name);
+    std::fs::write(
+        &path,
+        text.replacen(key, &format!("{key}scheme: {scheme}, "), 1),
+    )
+    .expect("write the scene copy");
+    path
+}
+
 /// Command output bytes as text.
 pub fn text(o: &[u8]) -> String {
     String::from_utf8_lossy(o).into_owned()

@@ -232,26 +232,14 @@ fn a_pressing_blade_matches_the_cpu() {
     let Some(ctx) = common::gpu_context() else {
         return;
     };
-    let start = Vec3::new(
-        0.011,
-        0.01,
-        common::PRESSED_TOP + common::PRESSED_BLADE_R + 0.001,
+    let start = pressing_start();
+    let (mut cpu, mut gpu) = pressed_pair(
+        &ctx,
+        NewtonParams {
+            steps: 2,
+            ..CONVERGED
+        },
     );
-    let block = || {
-        let params = SolverParams {
-            scheme: Scheme::Newton(NewtonParams {
-                steps: 2,
-                ..CONVERGED
-            }),
-            gravity: Vec3::ZERO,
-            damping: 10.0,
-            threads: 1,
-            ..SolverParams::default()
-        };
-        common::pressed_block(params, start)
-    };
-    let mut cpu = block();
-    let mut gpu = GpuSolver::new(block(), &ctx).expect("upload");
     let mut dent = 0.0;
     // Three nodes under the blade, pushed 3 mm down by frame 9 (after it they start to
     // slip off its spheres, a discontinuity rounding can shift by a frame).
@@ -323,24 +311,8 @@ fn a_plunging_blade_takes_the_frame_again_as_the_cpu_does() {
     let Some(ctx) = common::gpu_context() else {
         return;
     };
-    let start = Vec3::new(
-        0.011,
-        0.01,
-        common::PRESSED_TOP + common::PRESSED_BLADE_R + 0.001,
-    );
-    let block = || {
-        let params = SolverParams {
-            scheme: Scheme::Newton(NewtonParams::default()),
-            gravity: Vec3::ZERO,
-            damping: 10.0,
-            threads: 1,
-            ..SolverParams::default()
-        };
-        common::pressed_block(params, start)
-    };
-    let mut cpu = block();
-    let mut gpu = GpuSolver::new(block(), &ctx).expect("upload");
-    let pose = ToolPose::new(start - Vec3::Z * 0.006, glam::Quat::IDENTITY);
+    let (mut cpu, mut gpu) = pressed_pair(&ctx, NewtonParams::default());
+    let pose = ToolPose::new(pressing_start() - Vec3::Z * 0.006, glam::Quat::IDENTITY);
     cpu.move_tool(pose);
     gpu.move_tool(pose);
     let a = cpu.step_frame().unwrap();
@@ -371,4 +343,29 @@ fn a_plunging_blade_takes_the_frame_again_as_the_cpu_does() {
         a.tool_force,
         b.tool_force
     );
+}
+
+/// Where the pressing tests' blade starts: 1 mm above the pressed block.
+fn pressing_start() -> Vec3 {
+    Vec3::new(
+        0.011,
+        0.01,
+        common::PRESSED_TOP + common::PRESSED_BLADE_R + 0.001,
+    )
+}
+
+/// The pressed block (no gravity, damping 10/s, one thread) on the implicit scheme with
+/// `newton`, the blade at [`pressing_start`]: on the CPU and on the device.
+fn pressed_pair(ctx: &incise_sim::gpu::GpuContext, newton: NewtonParams) -> (Solver, GpuSolver) {
+    let block = || {
+        let params = SolverParams {
+            scheme: Scheme::Newton(newton),
+            gravity: Vec3::ZERO,
+            damping: 10.0,
+            threads: 1,
+            ..SolverParams::default()
+        };
+        common::pressed_block(params, pressing_start())
+    };
+    (block(), GpuSolver::new(block(), ctx).expect("upload"))
 }
