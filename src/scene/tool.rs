@@ -23,13 +23,9 @@ pub fn load(tool: &ToolSpec, stroke: &ToolStroke, scene_path: &Path) -> Result<(
     let t = load_tool_beside(scene_path, &tool.file)
         .with_context(|| format!("{}: tool", scene_path.display()))?;
     let s = match stroke {
-        ToolStroke::File(f) => {
-            let dir = scene_path.parent().unwrap_or(Path::new("."));
-            let (path, text) = super::built_in::config_text(dir, f)
-                .with_context(|| format!("{}: stroke", scene_path.display()))?;
-            parse_stroke(&text, &path)
-                .with_context(|| format!("{}: stroke", scene_path.display()))?
-        }
+        ToolStroke::File(f) => text_beside(scene_path, f)
+            .and_then(|(path, text)| Ok(parse_stroke(&text, &path)?))
+            .with_context(|| format!("{}: stroke", scene_path.display()))?,
         ToolStroke::Incision(i) => i
             .stroke(&t)
             .with_context(|| format!("{}: stroke.Incision", scene_path.display()))?,
@@ -39,7 +35,13 @@ pub fn load(tool: &ToolSpec, stroke: &ToolStroke, scene_path: &Path) -> Result<(
 
 /// The tool file `file` of the scene at `scene_path`: beside it, or config/'s built-in copy.
 pub fn load_tool_beside(scene_path: &Path, file: &str) -> Result<Tool> {
-    let dir = scene_path.parent().unwrap_or(Path::new("."));
-    let (path, text) = super::built_in::config_text(dir, file)?;
+    let (path, text) = text_beside(scene_path, file)?;
     Ok(parse_tool(&text, &path)?)
+}
+
+/// The file `file` named by the scene at `scene_path` (`built_in::config_text`): its text
+/// and the path that names it.
+fn text_beside(scene_path: &Path, file: &str) -> Result<(std::path::PathBuf, String)> {
+    let dir = scene_path.parent().unwrap_or(Path::new("."));
+    Ok(super::built_in::config_text(dir, file)?)
 }

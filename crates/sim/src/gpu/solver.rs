@@ -644,18 +644,15 @@ impl GpuSolver {
         };
         self.host.implicit_cost = Default::default();
         let (mut n, mut passes) = (steps, 0);
-        let released = loop {
-            let released = self.run_frame(n)?;
-            passes += self.host.passes;
-            if !split || n >= steps << MAX_SPLITS {
-                break released;
-            }
-            let gone: Vec<u32> = released
-                .iter()
+        // The mesh tets the frame's release checks switched off on the device.
+        let mesh_tets = loop {
+            let gone: Vec<u32> = (self.run_frame(n)?.iter())
                 .map(|&s| self.host.tet_of_slot[s as usize])
                 .collect();
-            if self.host.inverted_live_tets(&gone) <= inverted {
-                break released;
+            passes += self.host.passes;
+            if !split || n >= steps << MAX_SPLITS || self.host.inverted_live_tets(&gone) <= inverted
+            {
+                break gone;
             }
             self.restore_saved();
             self.host.implicit_cost.split_frames += 1;
@@ -674,10 +671,6 @@ impl GpuSolver {
             self.roll_back();
             return Err(e);
         }
-        let mesh_tets: Vec<u32> = released
-            .iter()
-            .map(|&s| self.host.tet_of_slot[s as usize])
-            .collect();
         let ev = self.host.release(&mesh_tets);
         self.retire_on_device(&ev.retired_nodes);
         if let Some(newton) = &mut self.newton {

@@ -23,21 +23,22 @@ const CONTACT_RESOLVES: usize = 1;
 /// (`Solver::run_implicit_steps`): at most 2^3 = 8 times the scene's steps.
 pub const MAX_SPLITS: u32 = 3;
 
-/// What a frame under the blade starts from, to take it back.
-struct FrameStart {
-    u: Vec<Vec3>,
-    v: Vec<Vec3>,
-    touched: Vec<bool>,
+/// The positions, velocities and nodes on the blade a frame started from (what
+/// `Solver::step_frame` saved for its guards).
+pub(crate) type Saved<'a> = (&'a [Vec3], &'a [Vec3], &'a [bool]);
+
+/// What a frame under the blade starts from, to take it back: `step_frame`'s saved state,
+/// the near-edge window and how many live tets were inverted.
+struct FrameStart<'a> {
+    saved: Saved<'a>,
     near_window: Vec<bool>,
     inverted: usize,
 }
 
-impl FrameStart {
-    fn of(s: &Solver) -> Self {
+impl<'a> FrameStart<'a> {
+    fn of(s: &Solver, saved: Saved<'a>) -> Self {
         FrameStart {
-            u: s.u.clone(),
-            v: s.v.clone(),
-            touched: s.touched.clone(),
+            saved,
             near_window: s.near_window.clone(),
             inverted: s.inverted_live_tets(&[]),
         }
@@ -45,9 +46,10 @@ impl FrameStart {
 
     /// Back to the frame's start: the tets its release checks switched off live again.
     fn restore(&self, s: &mut Solver) {
-        s.u.clone_from(&self.u);
-        s.v.clone_from(&self.v);
-        s.touched.clone_from(&self.touched);
+        let (u, v, touched) = self.saved;
+        s.u.copy_from_slice(u);
+        s.v.copy_from_slice(v);
+        s.touched.copy_from_slice(touched);
         s.near_window.clone_from(&self.near_window);
         s.near_edge.iter_mut().for_each(|b| *b = false);
         s.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
@@ -89,13 +91,14 @@ impl Solver {
     pub(crate) fn run_implicit_steps(
         &mut self,
         p: NewtonParams,
+        saved: Saved,
         parallel: bool,
     ) -> Result<bool, SolverError> {
         self.prepare_implicit(p)?;
         self.implicit_cost = Default::default();
         self.check_ms = 0.0;
         self.passes = 0;
-        let start = self.tool.is_some().then(|| FrameStart::of(self));
+        let start = self.tool.is_some().then(|| FrameStart::of(self, saved));
         let mut n = p.steps;
         loop {
             let fresh = self.implicit_steps(n, parallel);
@@ -154,11 +157,7 @@ impl Solver {
                 *u -= fall;
             }
         }
-        let live: Vec<bool> = self
-            .slot_of_tet
-            .iter()
-            .map(|&slot| self.slots[slot as usize].live)
-            .collect();
+        let live = self.live_tets();
         for pass in 0..=CONTACT_RESOLVES {
             let step_free: Vec<bool> = free.iter().zip(&held).map(|(f, h)| *f && !*h).collect();
             self.implicit_solve(&y, &live, &step_free, parallel);
@@ -182,9 +181,7 @@ impl Solver {
     /// Live tets whose volume ratio `J` is at most 0 where the nodes stand now, leaving
     /// out `gone` (tets released but not yet switched off in this mirror: the device's).
     pub(crate) fn inverted_live_tets(&self, gone: &[u32]) -> usize {
-        let mut live: Vec<bool> = (self.slot_of_tet.iter())
-            .map(|&slot| self.slots[slot as usize].live)
-            .collect();
+        let mut live = self.live_tets();
         for &t in gone {
             live[t as usize] = false;
         }

@@ -245,6 +245,14 @@ impl Solver {
         Ok(solver)
     }
 
+    /// Per mesh tet, whether it is live in the sweep now (its slot: release checks inside
+    /// a frame switch tets off here before the cut state hears of them).
+    pub(crate) fn live_tets(&self) -> Vec<bool> {
+        (self.slot_of_tet.iter())
+            .map(|&slot| self.slots[slot as usize].live)
+            .collect()
+    }
+
     /// Switch mesh tet `t` on or off in the sweep (its slot and packed lane).
     fn set_live(&mut self, t: u32, live: bool) {
         let s = self.slot_of_tet[t as usize] as usize;
@@ -495,7 +503,10 @@ impl Solver {
         self.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
         let fresh = match self.params.scheme {
             Scheme::Xpbd => self.with_pool(|s, parallel| s.run_substeps(parallel)),
-            Scheme::Newton(p) => self.with_pool(|s, parallel| s.run_implicit_steps(p, parallel))?,
+            Scheme::Newton(p) => {
+                let start = (&saved.0[..], &saved.1[..], &saved.2[..]);
+                self.with_pool(|s, parallel| s.run_implicit_steps(p, start, parallel))?
+            }
         };
         self.time += self.params.frame_dt as f64;
         self.sync_positions();

@@ -72,9 +72,7 @@ impl GpuSolver {
                 }
             }
             newton.start_step(&mut enc);
-            let live: Vec<bool> = (self.host.slot_of_tet.iter())
-                .map(|&slot| self.host.slots[slot as usize].live)
-                .collect();
+            let live = self.host.live_tets();
             let dev = OnDevice {
                 device: &self.device,
                 queue: &self.queue,
