@@ -7,7 +7,6 @@ use std::path::Path;
 use glam::{Quat, Vec2, Vec3};
 use incise_sim::contact::{ContactTool, ToolBox, ToolSphere};
 use incise_sim::ron_file;
-use parry3d::query::PointQuery;
 use parry3d::shape::Compound;
 
 use crate::error::{FieldError, FileError};
@@ -312,9 +311,17 @@ impl Tool {
     }
 
     /// Signed distance (m) from tool-frame point `p` to the body: positive outside,
-    /// negative inside (depth to the nearest face of the box containing it).
+    /// negative inside; the least of the boxes' signed distances, as the solver takes it.
+    ///
+    /// (A parry compound projects onto its nearest part, so a point inside the handle
+    /// but just outside the overlapping blade flat would come out positive.)
     pub fn body_distance(&self, p: Vec3) -> f32 {
-        self.body_shape.distance_to_local_point(to_parry(p), false)
+        let p = to_parry(p);
+        self.body_shape
+            .shapes()
+            .iter()
+            .map(|(pose, shape)| shape.distance_to_point(pose, p, false))
+            .fold(f32::INFINITY, f32::min)
     }
 }
 
