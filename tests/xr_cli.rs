@@ -571,6 +571,51 @@ fn a_session_of_one_simulation_frame_writes_its_report_without_a_stroke() {
     assert!(!out.join("stroke.ron").exists());
 }
 
+/// A 0.25 s plate-cut session on the virtual clock, 64 px eyes every frame, with
+/// `draw_eyes` as given (and `extra` fields).
+fn eyes_script(draw: bool, extra: &str) -> String {
+    format!(
+        "(display_hz: 72.0, duration: 0.25, eye_size: (64, 64), render_every: 1, \
+         draw_eyes: {draw}, {extra}
+         head: [(t: 0.0, position: (0.0, 1.25, -0.05), orientation: (-0.34202, 0.0, 0.0, 0.93969))])"
+    )
+}
+
+/// `draw_eyes: false` (the headset benchmark's "not drawn" rows): every frame is still
+/// shown, with its tool-to-tissue latency, but none is drawn; drawn, every shown one is.
+/// A screenshot asked of undrawn eyes is refused, naming the field.
+#[test]
+fn eyes_left_undrawn_still_show_every_frame_and_its_latency() {
+    for draw in [false, true] {
+        let (o, out) = run_xr(
+            &format!("xr-draw-{draw}"),
+            &eyes_script(draw, ""),
+            &["config/plate_cut.ron"],
+        );
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let r = xr_report(&out, &o);
+        assert_eq!(r["frames"].as_u64(), Some(18), "{r}");
+        assert_eq!(r["rendered"].as_u64(), Some(18), "{r}");
+        let drawn = if draw { 18 } else { 0 };
+        assert_eq!(r["drawn"].as_u64(), Some(drawn), "{r}");
+        // In-frame on the virtual clock: a frame shows its own step (0 ms) or the last.
+        assert!(latency_p50(&r) >= 0.0, "{r}");
+        let described = r["headset"].as_str().unwrap().contains("not drawn");
+        assert_eq!(described, !draw, "{r}");
+    }
+    let (o, _) = run_xr(
+        "xr-draw-shot",
+        &eyes_script(false, "screenshots: [3],"),
+        &["config/plate_cut.ron"],
+    );
+    let err = text(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("headset.ron") && err.contains("screenshots") && err.contains("draw_eyes"),
+        "{err}"
+    );
+}
+
 /// The plate-cut script on the wall clock (a frame that comes late skips the refreshes
 /// it missed, as on a runtime), 64 px eyes drawn every frame, substeps paced as on a
 /// headset; `incise xr` on it with `args`.

@@ -47,6 +47,8 @@ pub struct DisplayOutcome {
     pub frames: u64,
     /// Display frames rendered.
     pub rendered: u64,
+    /// Of those, the ones whose eyes were drawn (all unless the headset draws none).
+    pub drawn: u64,
     /// Wall time of the loop, s.
     pub wall_s: f64,
     /// How the session ended (`None`: the runtime never made it ready).
@@ -87,6 +89,7 @@ pub fn drive(
         out: DisplayOutcome {
             frames: 0,
             rendered: 0,
+            drawn: 0,
             wall_s: 0.0,
             exit: None,
             interrupted: false,
@@ -243,12 +246,19 @@ impl Display<'_, '_> {
                 label: Some("xr frame"),
             });
         picture.renderer.prepare(&mut enc, &picture.body, &settings);
-        picture.renderer.render(
-            &mut enc,
-            &[(views[0], &targets[0]), (views[1], &targets[1])],
-            self.headset.eye_size(),
-        );
-        self.dev.queue.submit([enc.finish()]);
+        if self.headset.draws_eyes() {
+            picture.renderer.render(
+                &mut enc,
+                &[(views[0], &targets[0]), (views[1], &targets[1])],
+                self.headset.eye_size(),
+            );
+            self.dev.queue.submit([enc.finish()]);
+            self.out.drawn += 1;
+        } else {
+            // The uploads go (they are the host's part); the skinning and the drawing
+            // recorded in `enc` are a GPU's, and are dropped.
+            self.dev.queue.submit([]);
+        }
         self.headset.end_frame(true)?;
         self.out.rendered += 1;
         Ok(true)

@@ -294,6 +294,7 @@ fn session_report(
         max_tool_force: live.max_force,
         haptic_pulses: shown.haptic_pulses,
         haptic_stops: shown.haptic_stops,
+        drawn: shown.drawn,
         dropped_time_s: end.dropped_time,
         sim_steps_per_s: if wall > 0.0 {
             live.frames as f64 / wall

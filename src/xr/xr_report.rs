@@ -60,6 +60,9 @@ pub struct XrReport {
     pub frames: u64,
     /// Display frames rendered (ended with a projection layer).
     pub rendered: u64,
+    /// Of those, the ones whose eyes were drawn: all but on a simulated headset told not
+    /// to draw them (`draw_eyes: false`), whose frames are prepared but not drawn.
+    pub drawn: u64,
     /// Simulation frames stepped (another method: its body's frames; on its thread it may
     /// step a few more after the last display frame showed one, which `frames.csv`'s
     /// `sim_frames` then leave out).

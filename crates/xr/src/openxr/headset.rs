@@ -50,6 +50,11 @@ pub trait Headset {
     fn describe(&self) -> String;
     /// What the organ is seen against (sets the eye images' clear colour and alpha).
     fn backdrop(&self) -> Backdrop;
+    /// Whether the eye images are drawn (false: a simulated headset measuring the
+    /// simulation alone, `draw_eyes: false`).
+    fn draws_eyes(&self) -> bool {
+        true
+    }
     /// Poll events, wait for the next frame and begin it.
     fn next_frame(&mut self) -> Result<FrameEvent, XrError>;
     /// Acquire the begun frame's eye targets: one view per eye in eye order.

@@ -259,13 +259,22 @@ impl Headset for SimulatedHeadset {
         }
     }
 
+    fn draws_eyes(&self) -> bool {
+        self.script.draw_eyes
+    }
+
     fn format(&self) -> wgpu::TextureFormat {
         FORMAT
     }
 
     fn describe(&self) -> String {
+        let drawn = if self.script.draw_eyes {
+            ""
+        } else {
+            ", eyes prepared but not drawn"
+        };
         format!(
-            "simulated headset ({}×{} per eye at {} Hz) on {}",
+            "simulated headset ({}×{} per eye at {} Hz{drawn}) on {}",
             self.script.eye_size.0,
             self.script.eye_size.1,
             self.script.display_hz,

@@ -42,6 +42,12 @@ pub struct HeadsetScript {
     /// Display frames whose two eye images are saved as PNGs.
     #[serde(default)]
     pub screenshots: Vec<u64>,
+    /// Draw the eye images (the default). Off: each frame to be drawn still takes the
+    /// simulation's picture and uploads it, but its drawing is never submitted, as if a
+    /// GPU that costs these cores nothing drew it (lavapipe draws on the cores the solver
+    /// runs on): what the simulation alone adds to the latency.
+    #[serde(default = "default_draw")]
+    pub draw_eyes: bool,
     /// Show the room through passthrough (the eye images are transparent around the
     /// organ) instead of the opaque neutral room.
     #[serde(default)]
@@ -110,6 +116,9 @@ fn default_ipd() -> f32 {
 }
 fn default_every() -> u64 {
     1
+}
+fn default_draw() -> bool {
+    true
 }
 fn default_fov() -> FovSpec {
     // Of the order a Quest 3 runtime reports for the left eye (wider towards the nose
@@ -220,6 +229,12 @@ impl HeadsetScript {
         }
         if self.render_every == 0 {
             return bad("render_every", "must be at least 1".into());
+        }
+        if !self.draw_eyes && !self.screenshots.is_empty() {
+            return bad(
+                "screenshots",
+                "the eyes are not drawn (`draw_eyes: false`): nothing to save".into(),
+            );
         }
         if !(self.ipd.is_finite() && (0.0..0.2).contains(&self.ipd)) {
             return bad("ipd", format!("must be 0 to 0.2 m, got {}", self.ipd));
