@@ -345,6 +345,49 @@ fn a_plunging_blade_takes_the_frame_again_as_the_cpu_does() {
     );
 }
 
+/// The tets the pressing blade crushes fail the release check, and the device gives their
+/// share of the held nodes' reactions back as the CPU does (`unload`): the same force,
+/// frame by frame, through the frames that release them.
+#[test]
+fn a_blade_that_releases_what_it_crushes_pushes_as_on_the_cpu() {
+    use incise_sim::contact::ToolPose;
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
+    let block = || {
+        let params = SolverParams {
+            scheme: Scheme::Newton(NewtonParams::default()),
+            gravity: Vec3::ZERO,
+            damping: 10.0,
+            threads: 1,
+            release_threshold: Some(3e3),
+            ..SolverParams::default()
+        };
+        common::pressed_block(params, pressing_start())
+    };
+    let (mut cpu, mut gpu) = (block(), GpuSolver::new(block(), &ctx).expect("upload"));
+    let mut released = 0;
+    for frame in 0..8 {
+        let to = pressing_start() - Vec3::Z * (0.0006 * (frame + 1) as f32);
+        let pose = ToolPose::new(to, glam::Quat::IDENTITY);
+        cpu.move_tool(pose);
+        gpu.move_tool(pose);
+        let a = cpu.step_frame().unwrap();
+        let b = gpu.step_frame().unwrap();
+        assert_eq!(a.released_now, b.released_now, "frame {frame}");
+        released += a.released_now;
+        let df = (a.tool_force - b.tool_force).length();
+        assert!(
+            df <= 1e-2 * a.tool_force.length().max(1e-3),
+            "frame {frame} ({} released): tool force {} N on the CPU, {} N on the device",
+            a.released_now,
+            a.tool_force,
+            b.tool_force
+        );
+    }
+    assert!(released >= 3, "the blade released {released} tets");
+}
+
 /// Where the pressing tests' blade starts: 1 mm above the pressed block.
 fn pressing_start() -> Vec3 {
     Vec3::new(

@@ -510,3 +510,54 @@ fn a_pressing_blade_meets_the_tissue_as_the_xpbd_reference_does() {
         );
     }
 }
+
+/// Failed tissue carries no load: the frame whose release check switches off the tets the
+/// blade crushes books the blade's force without them. The same press with and without a
+/// release threshold is the same solve, bit for bit, until that frame; then the force is
+/// lower by the released tets' share (it was the same before `Solver::unload_released`,
+/// and on the intestine a crushed tet put 123 N on a scalpel for one frame).
+#[test]
+fn a_tet_the_blade_crushes_and_releases_puts_no_force_on_it() {
+    use incise_sim::contact::ToolPose;
+    let start = Vec3::new(
+        0.011,
+        0.01,
+        common::PRESSED_TOP + common::PRESSED_BLADE_R + 0.0002,
+    );
+    let block = |release_threshold: Option<f32>| {
+        let params = SolverParams {
+            scheme: Scheme::Newton(NewtonParams::default()),
+            gravity: Vec3::ZERO,
+            damping: 10.0,
+            release_threshold,
+            ..SolverParams::default()
+        };
+        common::pressed_block(params, start)
+    };
+    // 3 kPa: reached under the blade at its sixth frame (2.5 mm deep).
+    let (mut cutting, mut whole) = (block(Some(3e3)), block(None));
+    for frame in 0..10 {
+        let pose = ToolPose::new(
+            start - Vec3::Z * (0.0004 * (frame + 1) as f32),
+            glam::Quat::IDENTITY,
+        );
+        cutting.move_tool(pose);
+        whole.move_tool(pose);
+        let (a, b) = (cutting.step_frame().unwrap(), whole.step_frame().unwrap());
+        assert_eq!(cutting.positions(), whole.positions(), "frame {frame}");
+        if a.released_now == 0 {
+            assert_eq!(a.tool_force, b.tool_force, "frame {frame}");
+            continue;
+        }
+        assert!(
+            a.tool_force.z < 0.95 * b.tool_force.z,
+            "frame {frame}: {} tets released under the blade, yet {} N on it against {} N \
+             with them whole",
+            a.released_now,
+            a.tool_force.z,
+            b.tool_force.z
+        );
+        return;
+    }
+    panic!("the blade released no tet in 10 frames");
+}

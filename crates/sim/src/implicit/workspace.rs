@@ -249,6 +249,12 @@ impl NewtonWorkspace {
         self.hessian.node_sums(u, y, node).0
     }
 
+    /// Tet `t`'s share of [`NewtonWorkspace::reaction`] at its corner `a` (its elastic
+    /// energy's gradient there at the last iterate), N.
+    pub fn corner_reaction(&self, t: usize, a: usize) -> Vec3 {
+        self.hessian.evals.force(t, a)
+    }
+
     /// Re-assemble the coarse matrix from the live tets' current tangents and refactorise
     /// it (the previous factor stays where the new one fails).
     fn refresh_coarse(&mut self, live: &[bool], parallel: bool) -> Result<(), CoarseError> {

@@ -126,19 +126,38 @@ impl Solver {
         let mut fresh = false;
         self.passes += checks.len() as u32;
         for s in 0..n {
-            self.implicit_step((s, n), &free, parallel);
+            let held = self.implicit_step((s, n), &free, parallel);
             fresh = next.next_if(|&&k| k == s).is_some();
             if fresh {
+                let before = self.pending.len();
                 self.release_check(parallel);
+                self.unload_released(h, &held, before);
             }
         }
         fresh
     }
 
+    /// Failed tissue carries no load: the tets the step's release check switched off
+    /// (`pending[from..]`) taken out of the reactions booked at the nodes the step `held`
+    /// (a tet crushed under the blade fails the check; its force, which can reach
+    /// hundreds of newtons as it inverts, would otherwise reach the tool for the frame).
+    fn unload_released(&mut self, h: f32, held: &[bool], from: usize) {
+        let Some(ws) = &self.newton else {
+            return;
+        };
+        for &t in &self.pending[from..] {
+            for (a, &k) in self.mesh.tets[t as usize].iter().enumerate() {
+                if held[k as usize] {
+                    self.contact_push[k as usize] -= h * h * ws.corner_reaction(t as usize, a);
+                }
+            }
+        }
+    }
+
     /// One implicit Euler step, `s` of `n` in the frame: prediction, the nodes in the
     /// tool's path held, the solve (again with the nodes it carried into the tool), the
-    /// held nodes' reactions, contact and velocities.
-    fn implicit_step(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool) {
+    /// held nodes' reactions, contact and velocities; returns the nodes it held.
+    fn implicit_step(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool) -> Vec<bool> {
         let h = self.params.frame_dt / n as f32;
         let t = self.time + (s + 1) as f64 * h as f64;
         self.predict(h, t);
@@ -176,6 +195,7 @@ impl Solver {
         self.push_held(h, &y, &held);
         self.project_contacts(s, n);
         self.update_velocities(h);
+        held
     }
 
     /// Live tets whose volume ratio `J` is at most 0 where the nodes stand now, leaving

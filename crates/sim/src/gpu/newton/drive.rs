@@ -88,6 +88,13 @@ impl GpuNewton {
         self.dispatches += record(enc, &[(&self.kernels.reaction, &self.bind.nodes, ng)]);
     }
 
+    /// Record the step's unload after its release check: the held nodes' reactions give
+    /// back the tets the check switched off (CPU twin: `Solver::unload_released`).
+    pub fn record_unload(&mut self, enc: &mut wgpu::CommandEncoder) {
+        let (ng, _, _) = self.groups;
+        self.dispatches += record(enc, &[(&self.kernels.unload, &self.bind.nodes, ng)]);
+    }
+
     /// Minimise `G` from the iterate in `pos`: right after [`GpuNewton::start_step`]
     /// (which set the point to evaluate), or, `again`, as a further solve of the step
     /// left it and the contact moved it since; `enc` holds the commands recorded so far.

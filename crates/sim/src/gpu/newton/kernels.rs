@@ -36,7 +36,7 @@ const TETS: [Slot; 7] = [
     Slot::Write,
     Slot::Write,
 ];
-const NODES: [Slot; 8] = [
+const NODES: [Slot; 9] = [
     Slot::Uniform,
     Slot::Write,
     Slot::Write,
@@ -45,6 +45,7 @@ const NODES: [Slot; 8] = [
     Slot::Read,
     Slot::Write,
     Slot::Write,
+    Slot::Read,
 ];
 const CG: [Slot; 7] = [
     Slot::Uniform,
@@ -72,6 +73,7 @@ pub(crate) struct NewtonKernels {
     pub gather_product: wgpu::ComputePipeline,
     pub resume: wgpu::ComputePipeline,
     pub reaction: wgpu::ComputePipeline,
+    pub unload: wgpu::ComputePipeline,
     pub restrict_init: wgpu::ComputePipeline,
     pub coarse_solve: wgpu::ComputePipeline,
     pub precondition_init: wgpu::ComputePipeline,
@@ -146,6 +148,7 @@ impl NewtonKernels {
             gather_product: pipeline(&nodes, &nodes_layout, "gather_product"),
             resume: pipeline(&nodes, &nodes_layout, "resume"),
             reaction: pipeline(&nodes, &nodes_layout, "reaction"),
+            unload: pipeline(&nodes, &nodes_layout, "unload"),
             restrict_init: pipeline(&cg, &cg_layout, "restrict_init"),
             coarse_solve: pipeline(&cg, &cg_layout, "coarse_solve"),
             precondition_init: pipeline(&cg, &cg_layout, "precondition_init"),

@@ -268,6 +268,7 @@ impl GpuNewton {
                     &b.inc,
                     &b.scratch,
                     shared.push,
+                    shared.live,
                 ],
             ),
             cg: self::bind(

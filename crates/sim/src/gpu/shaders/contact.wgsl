@@ -258,7 +258,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (any(p != x_in)) {
         pos[i] = vec4<f32>(p - rest_pos[i].xyz, cur.w);
         // m Δx with m = 1 / w (free nodes have w > 0).
-        push[i] = vec4<f32>(push[i].xyz + (p - x_in) / cur.w, 0.0);
+        // (w: the implicit scheme's mark of a node its solve held, kept.)
+        push[i] = vec4<f32>(push[i].xyz + (p - x_in) / cur.w, push[i].w);
     }
 }
 

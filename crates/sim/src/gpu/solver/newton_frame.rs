@@ -96,24 +96,12 @@ impl GpuSolver {
             }
             self.host.implicit_cost.add(&r);
             self.host.coarse_nodes = r.coarse_nodes;
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("newton step end"),
-                timestamp_writes: None,
-            });
-            if self.host.tool.is_some() {
-                pass.set_pipeline(&self.kernels.contact);
-                pass.set_bind_group(0, &self.bind.contact, &[]);
-                pass.set_bind_group(1, &self.bind.contact_steps[s], &[]);
-                pass.dispatch_workgroups(groups(nodes), 1, 1);
-                dispatches += 1;
-            }
-            pass.set_pipeline(&self.kernels.velocity);
-            pass.set_bind_group(0, &self.bind.velocity, &[]);
-            pass.dispatch_workgroups(groups(nodes), 1, 1);
-            dispatches += 1;
             fresh = checks.contains(&(s as u32));
-            if fresh {
-                dispatches += self.record_release_check(&mut pass);
+            dispatches += self.record_step_end(&mut enc, s, fresh);
+            if self.host.tool.is_some() {
+                // After every step, so a held node's mark clears (without a check no tet
+                // went since the solve, and nothing is given back).
+                newton.record_unload(&mut enc);
             }
         }
         if !fresh {
@@ -125,6 +113,32 @@ impl GpuSolver {
         }
         self.host.passes = dispatches;
         Ok(enc)
+    }
+
+    /// Record step `s`'s end after `enc`: the contact with a tool, the velocities and,
+    /// when `check`, the release check; returns the dispatches.
+    fn record_step_end(&self, enc: &mut wgpu::CommandEncoder, s: usize, check: bool) -> u32 {
+        let nodes = self.host.x.len();
+        let mut dispatches = 0;
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("newton step end"),
+            timestamp_writes: None,
+        });
+        if self.host.tool.is_some() {
+            pass.set_pipeline(&self.kernels.contact);
+            pass.set_bind_group(0, &self.bind.contact, &[]);
+            pass.set_bind_group(1, &self.bind.contact_steps[s], &[]);
+            pass.dispatch_workgroups(groups(nodes), 1, 1);
+            dispatches += 1;
+        }
+        pass.set_pipeline(&self.kernels.velocity);
+        pass.set_bind_group(0, &self.bind.velocity, &[]);
+        pass.dispatch_workgroups(groups(nodes), 1, 1);
+        dispatches += 1;
+        if check {
+            dispatches += self.record_release_check(&mut pass);
+        }
+        dispatches
     }
 
     /// Record the contact kernel's `resolve` for step `s` after `enc`, submit and read how

@@ -12,8 +12,10 @@
 @group(0) @binding(4) var<storage, read> tet_out: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> inc: array<u32>;
 @group(0) @binding(6) var<storage, read_write> scratch: array<f32>;
-// The contact kernel's per-node push (contact.wgsl): `reaction` books the held nodes'.
+// The contact kernel's per-node push (contact.wgsl): `reaction` books the held nodes'
+// (w: 1 until `unload` has run after the step).
 @group(0) @binding(7) var<storage, read_write> push: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read> live: array<u32>;
 
 fn is_free(i: u32) -> bool {
     return kind[i] == KIND_FREE;
@@ -62,7 +64,27 @@ fn reaction(@builtin(global_invocation_id) gid: vec3<u32>) {
         let e = inc[k];
         g += tet_out[(e >> 2u) * TET_STRIDE + FORCE + (e & 3u)].xyz;
     }
-    push[i] = vec4<f32>(push[i].xyz + g / NW.inv_h2, 0.0);
+    push[i] = vec4<f32>(push[i].xyz + g / NW.inv_h2, 1.0);
+}
+
+// Failed tissue carries no load (CPU twin: Solver::unload_released), after the step's
+// release check: a node `reaction` booked gives back the corner forces of its tets the
+// check switched off (a tet released before the step evaluated to zero), and its mark
+// clears.
+@compute @workgroup_size(64)
+fn unload(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= NW.node_count || push[i].w == 0.0) {
+        return;
+    }
+    var g = vec3<f32>(0.0);
+    for (var k = inc[i]; k < inc[i + 1u]; k++) {
+        let e = inc[k];
+        if (live[e >> 2u] == 0u) {
+            g += tet_out[(e >> 2u) * TET_STRIDE + FORCE + (e & 3u)].xyz;
+        }
+    }
+    push[i] = vec4<f32>(push[i].xyz - g / NW.inv_h2, 0.0);
 }
 
 // grad G = M/h^2 (u - y) + sum of the corner forces, and the inverse of
