@@ -47,8 +47,7 @@ pub struct Comparison {
     pub max_position_difference: f32,
     /// Frame of that largest distance.
     pub worst_frame: u64,
-    /// Largest node distance over all frames, the torn tissue's included, m (reported,
-    /// not judged).
+    /// Largest node distance over the frames after the tear, m (reported, not judged).
     pub max_position_difference_after_tear: f32,
     /// Tets released by the CPU run.
     pub released_cpu: usize,
@@ -66,6 +65,31 @@ pub struct Comparison {
 }
 
 impl Comparison {
+    /// Book frame `f` of the two runs: their largest node distance (judged up to and
+    /// including the tear, reported after it), the tear, the first differing releases.
+    fn add_frame(&mut self, f: u64, cpu: &incise_sim::Solver, gpu: &incise_sim::Solver) {
+        let d = cpu
+            .positions()
+            .iter()
+            .zip(gpu.positions())
+            .map(|(p, q)| (*p - *q).length())
+            .fold(0.0, f32::max);
+        if self.tear_frame.is_some() {
+            self.max_position_difference_after_tear =
+                self.max_position_difference_after_tear.max(d);
+        } else if d > self.max_position_difference {
+            (self.max_position_difference, self.worst_frame) = (d, f);
+        }
+        if self.tear_frame.is_none() && cpu.cut().released_count() + gpu.cut().released_count() > 0
+        {
+            self.tear_frame = Some(f);
+        }
+        if self.first_mismatch_frame.is_none() && cpu.cut().live() != gpu.cut().live() {
+            self.first_mismatch_frame = Some(f);
+            self.mismatch_stress_distance = Some(stress_distance(cpu, gpu));
+        }
+    }
+
     /// The verdict: positions within [`POSITION_TOLERANCE`] up to the tear, the first
     /// differing releases borderline, the released counts within [`RELEASED_TOLERANCE`].
     fn judged(&self) -> bool {
@@ -109,24 +133,7 @@ pub fn compare(scene_path: &Path, frames: u64, threads: Option<usize>) -> Result
     for f in 0..frames {
         cpu.step_frame()?;
         gpu.step_frame()?;
-        let (a, b) = (cpu.solver(), gpu.solver());
-        let d = a
-            .positions()
-            .iter()
-            .zip(b.positions())
-            .map(|(p, q)| (*p - *q).length())
-            .fold(0.0, f32::max);
-        c.max_position_difference_after_tear = c.max_position_difference_after_tear.max(d);
-        if c.tear_frame.is_none() && d > c.max_position_difference {
-            (c.max_position_difference, c.worst_frame) = (d, f);
-        }
-        if c.tear_frame.is_none() && a.cut().released_count() + b.cut().released_count() > 0 {
-            c.tear_frame = Some(f);
-        }
-        if c.first_mismatch_frame.is_none() && a.cut().live() != b.cut().live() {
-            c.first_mismatch_frame = Some(f);
-            c.mismatch_stress_distance = Some(stress_distance(a, b));
-        }
+        c.add_frame(f, cpu.solver(), gpu.solver());
     }
     let (a, b) = (cpu.solver().cut(), gpu.solver().cut());
     c.released_mismatch = a
