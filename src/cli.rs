@@ -66,9 +66,9 @@ pub enum Command {
         /// Scene file (RON) or a built-in scene's name.
         #[arg(value_parser = config_file)]
         scene: PathBuf,
-        /// Frames to compare.
-        #[arg(long, default_value_t = 200)]
-        frames: u64,
+        /// Frames to compare (default: the scene's duration).
+        #[arg(long)]
+        frames: Option<u64>,
         /// CPU solver threads (0: all cores).
         #[arg(long)]
         threads: Option<usize>,

@@ -103,13 +103,23 @@ impl Comparison {
     }
 }
 
-/// Run `scene` for `frames` frames on both devices and compare frame by frame.
-pub fn compare(scene_path: &Path, frames: u64, threads: Option<usize>) -> Result<Comparison> {
+/// Run `scene` for `frames` frames (its duration: `None`) on both devices and compare
+/// frame by frame.
+pub fn compare(
+    scene_path: &Path,
+    frames: Option<u64>,
+    threads: Option<usize>,
+) -> Result<Comparison> {
     let scene = load_scene(scene_path)?;
     let cpu = build_scene(&scene, scene_path, threads)?.solver;
     let gpu = build_scene(&scene, scene_path, threads)?.solver;
     let mut cpu = Body::place(cpu, DeviceChoice::Cpu, |_| {})?;
     let mut gpu = Body::place(gpu, DeviceChoice::Gpu, |_| {})?;
+    let frames = frames.unwrap_or_else(|| {
+        (scene.duration as f64 / cpu.solver().params().frame_dt as f64)
+            .round()
+            .max(1.0) as u64
+    });
     let size = {
         let (lo, hi) = cpu.solver().mesh().rest_bounds();
         (hi - lo).length()
@@ -162,7 +172,7 @@ fn stress_distance(cpu: &incise_sim::Solver, gpu: &incise_sim::Solver) -> f32 {
 }
 
 /// CLI entry: print the comparison (text or JSON); exit 1 when the runs disagree.
-pub fn run(scene: &Path, frames: u64, threads: Option<usize>, json: bool) -> Result<()> {
+pub fn run(scene: &Path, frames: Option<u64>, threads: Option<usize>, json: bool) -> Result<()> {
     let c = compare(scene, frames, threads)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&c)?);

@@ -667,15 +667,11 @@ fn compare_finds_cpu_and_gpu_in_agreement() {
     ] {
         let scene = dir.join(name);
         std::fs::write(&scene, text_).unwrap();
-        let o = incise(&[
-            "compare",
-            scene.to_str().unwrap(),
-            "--frames",
-            "30",
-            "--json",
-        ]);
+        // Without --frames: the scene's duration, 0.5 s at 60 Hz.
+        let o = incise(&["compare", scene.to_str().unwrap(), "--json"]);
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));
         let c: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(c["frames"], 30, "{name}: {c}");
         assert_eq!(c["agree"], true, "{name}: {c}");
         assert!(c["released_cpu"].as_u64().unwrap() > 0, "{name}: {c}");
         assert_eq!(c["released_mismatch"], 0, "{name}: {c}");
