@@ -128,6 +128,44 @@ fn simulated_headset_renders_both_eyes_and_the_controller_stroke_cuts() {
     // Frame-time log: a header and one row per display frame.
     let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
     assert_eq!(csv.lines().count(), 203);
+    // A display frame between simulation frames (one in six: 72 Hz on 60) keeps the
+    // tissue's push and the controller's vibration; it does not drop them to zero.
+    let column = |name: &str| {
+        csv.lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .position(|c| c == name)
+    };
+    let (sims, force, haptic) = (
+        column("sim_frames").unwrap(),
+        column("tool_force_n").unwrap(),
+        column("haptic").unwrap(),
+    );
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|c| c.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let mut held = 0;
+    for w in rows.windows(2) {
+        if w[1][sims] == 0.0 && w[0][force] > 0.0 {
+            held += 1;
+            assert_eq!(
+                (w[1][force], w[1][haptic]),
+                (w[0][force], w[0][haptic]),
+                "a frame without a simulation step after {w:?}"
+            );
+        }
+    }
+    assert!(
+        held >= 5,
+        "{held} frames between simulation frames while cutting"
+    );
 
     // The recorded stroke follows the incision line (x 1.5 → 5.5 cm at y = 2 cm).
     let stroke = incise_scalpel::load_stroke(&out.join("stroke.ron")).unwrap();
