@@ -30,7 +30,7 @@ pub const RELEASED_TOLERANCE: f64 = 0.02;
 /// by its outcome: the released sets may first differ only in tets whose stress was
 /// within [`BORDERLINE`] of the threshold, and the counts at the end within
 /// [`RELEASED_TOLERANCE`] (docs/physics-notes.md, "Which scheme a scene runs").
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct Comparison {
     /// Scene name.
     pub scene: String,
@@ -115,11 +115,7 @@ pub fn compare(
     let gpu = build_scene(&scene, scene_path, threads)?.solver;
     let mut cpu = Body::place(cpu, DeviceChoice::Cpu, |_| {})?;
     let mut gpu = Body::place(gpu, DeviceChoice::Gpu, |_| {})?;
-    let frames = frames.unwrap_or_else(|| {
-        (scene.duration as f64 / cpu.solver().params().frame_dt as f64)
-            .round()
-            .max(1.0) as u64
-    });
+    let frames = frames.unwrap_or_else(|| scene.frame_count(cpu.solver().params().frame_dt as f64));
     let size = {
         let (lo, hi) = cpu.solver().mesh().rest_bounds();
         (hi - lo).length()
@@ -129,16 +125,7 @@ pub fn compare(
         frames,
         device: gpu.device(),
         mesh_size: size,
-        tear_frame: None,
-        max_position_difference: 0.0,
-        worst_frame: 0,
-        max_position_difference_after_tear: 0.0,
-        released_cpu: 0,
-        released_gpu: 0,
-        released_mismatch: 0,
-        first_mismatch_frame: None,
-        mismatch_stress_distance: None,
-        agree: false,
+        ..Comparison::default()
     };
     for f in 0..frames {
         cpu.step_frame()?;

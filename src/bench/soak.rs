@@ -172,7 +172,7 @@ fn cut_once(scene_path: &Path, opts: &OpenOptions) -> Result<Cut> {
     let scene = load_scene(scene_path)?;
     check_scripted(&scene, scene_path)?;
     let (mut body, mut report) = open(&scene, scene_path, opts)?;
-    let frames = (scene.duration as f64 / body.frame_dt()).round().max(1.0) as u64;
+    let frames = scene.frame_count(body.frame_dt());
     let mut times = Vec::with_capacity(frames as usize);
     let mut free_nodes = Vec::new();
     for f in 0..frames {

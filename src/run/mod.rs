@@ -33,7 +33,7 @@ pub fn run_scene(opts: &RunOptions) -> Result<RunOutcome> {
     let (body, report) = open(&scene, &opts.scene, &open_options(opts)?)?;
     let frames = opts
         .frames
-        .unwrap_or_else(|| (scene.duration as f64 / body.frame_dt()).round().max(1.0) as u64);
+        .unwrap_or_else(|| scene.frame_count(body.frame_dt()));
     let (mut body, mut report, stopped) =
         FrameLoop::new(body, report, opts, frames)?.run(frames)?;
     let closing = body.finish(&mut report)?;

@@ -75,6 +75,13 @@ pub struct Scene {
     pub stroke: Option<incise_scalpel::ToolStroke>,
 }
 
+impl Scene {
+    /// Frames the scene runs at `frame_dt` s a frame: its duration, rounded, at least one.
+    pub fn frame_count(&self, frame_dt: f64) -> u64 {
+        (self.duration as f64 / frame_dt).round().max(1.0) as u64
+    }
+}
+
 /// Where a tet mesh comes from.
 #[derive(Debug, Clone, Deserialize)]
 pub enum MeshSource {
