@@ -5,7 +5,9 @@
 //! mean von Mises stress against the 200-substep XPBD answer, and ms per frame.
 //! The open cantilever requirement (issue 31: VBD within 5 % of XPBD-200) is measured by
 //! `VBD_GRID=15x20 VBD_RHO=0.9 VBD_SCENES=beam cargo run --release -p incise-sim --example
-//! vbd_measure` (docs/physics-notes.md, "Open item").
+//! vbd_measure` (docs/physics-notes.md, "Open item"); `VBD_SCENES=implicit,implicit-tight
+//! VBD_GRID=` measures the scenes' default scheme (implicit Euler by Newton) on the same
+//! cantilever, at its default settings and solved tight.
 
 #[path = "../tests/vbd_support/mod.rs"]
 mod vbd_support;
@@ -92,6 +94,50 @@ fn run_vbd_beam(s: &mut VbdSolver, tip: &[u32], hz: f32) -> (Option<f32>, f64) {
     (ok.then_some(sag), median(&mut ms))
 }
 
+/// The implicit-scheme rows `VBD_SCENES` asks for: `implicit`, the default settings, and
+/// `implicit-tight`, Newton run to the static answer of each step (30 iterations, CG to
+/// 10⁻⁴, no early stop) besides.
+fn implicit_settings(scenes: &str) -> Vec<(&'static str, incise_sim::implicit::NewtonParams)> {
+    use incise_sim::implicit::NewtonParams;
+    let mut rows = Vec::new();
+    if scenes.split(',').any(|s| s.trim() == "implicit") {
+        rows.push(("default settings", NewtonParams::default()));
+    }
+    if scenes.split(',').any(|s| s.trim() == "implicit-tight") {
+        let tight = NewtonParams {
+            iterations: 30,
+            cg_iterations: 1000,
+            cg_tolerance: 1e-4,
+            gradient_tolerance: 0.0,
+            step_tolerance: 0.0,
+            ..NewtonParams::default()
+        };
+        rows.push(("30 iterations, CG to 1e-4", tight));
+    }
+    rows
+}
+
+/// Tip sag of an XPBD or implicit-scheme run averaged over the window (None if a step
+/// failed or it ended non-finite), and median ms/frame.
+fn run_solver_beam(s: &mut incise_sim::Solver, tip: &[u32], hz: f32) -> (Option<f32>, f64) {
+    let (settle, avg) = beam_frames(hz);
+    let rest = s.mesh().rest_positions.clone();
+    let mut ms = Vec::new();
+    let mut sum = 0.0;
+    for f in 0..settle + avg {
+        let t = std::time::Instant::now();
+        if s.step_frame().is_err() {
+            return (None, median(&mut ms));
+        }
+        ms.push(t.elapsed().as_secs_f64() * 1e3);
+        if f >= settle {
+            sum += tip_sag(&rest, s.positions(), tip);
+        }
+    }
+    let sag = sum / avg as f32;
+    (sag.is_finite().then_some(sag), median(&mut ms))
+}
+
 /// `‖a − b‖ / ‖b‖` of two per-tet fields.
 fn field_error(a: &[f32], b: &[f32]) -> f32 {
     let d: f64 = a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum();
@@ -142,18 +188,9 @@ fn main() {
         } else {
             let mut b = None;
             let mut p = None;
-            if scenes.contains("beam") {
+            if scenes.contains("beam") || scenes.contains("implicit") {
                 let (mut s, tip) = xpbd_cantilever(hz, xpbd_sub);
-                let (settle, avg) = beam_frames(hz);
-                let rest = s.mesh().rest_positions.clone();
-                let mut sum = 0.0;
-                for f in 0..settle + avg {
-                    s.step_frame().expect("XPBD reference runs");
-                    if f >= settle {
-                        sum += tip_sag(&rest, s.positions(), &tip);
-                    }
-                }
-                b = Some(sum / avg as f32);
+                b = run_solver_beam(&mut s, &tip, hz).0;
             }
             if scenes.contains("pull") {
                 let mut s = xpbd_pull(hz, xpbd_sub);
@@ -219,8 +256,25 @@ fn main() {
     }
     println!("| scene | substeps | iterations | stable | value | vs XPBD-{xpbd_sub} | ms/frame |");
     println!("|---|---:|---:|---|---:|---:|---:|");
+    for (name, newton) in implicit_settings(&scenes) {
+        // The scenes' default scheme on the same beam, damping and frames.
+        let r = beam_ref.expect("the implicit rows run the XPBD reference");
+        let (mut s, tip) = implicit_cantilever(hz, newton);
+        let (sag, ms) = run_solver_beam(&mut s, &tip, hz);
+        match sag {
+            Some(v) => println!(
+                "| cantilever, implicit Euler ({name}) | – | – | yes | {:.3} cm | {:+.1} % | {ms:.1} |",
+                v * 100.0,
+                (v / r - 1.0) * 100.0
+            ),
+            None => println!(
+                "| cantilever, implicit Euler ({name}) | – | – | **no** | – | – | {ms:.1} |"
+            ),
+        }
+    }
+    let scenes_beam = scenes.contains("beam");
     for (sub, it) in grid() {
-        if let Some(r) = beam_ref {
+        if let (Some(r), true) = (beam_ref, scenes_beam) {
             let mut p = vbd_params(hz, sub, it, true, BEAM_DAMPING);
             tune(&mut p);
             let (mut s, tip) = vbd_cantilever(p);

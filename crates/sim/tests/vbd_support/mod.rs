@@ -4,6 +4,7 @@
 use glam::{UVec3, Vec3};
 use incise_sim::generate::block;
 use incise_sim::grab::Grab;
+use incise_sim::implicit::{NewtonParams, Scheme};
 use incise_sim::vbd::{VbdParams, VbdSolver};
 use incise_sim::{Material, Solver, SolverParams, TetMesh};
 
@@ -118,10 +119,21 @@ pub fn vbd_cantilever(params: VbdParams) -> (VbdSolver, Vec<u32>) {
 
 /// The cantilever on XPBD (rest-free pair, the solver's defaults otherwise).
 pub fn xpbd_cantilever(hz: f32, substeps: u32) -> (Solver, Vec<u32>) {
+    scheme_cantilever(hz, substeps, Scheme::Xpbd)
+}
+
+/// The cantilever on the implicit scheme (`NewtonParams::default()`: one implicit Euler
+/// step a frame, the scenes' default scheme), the same damping as the XPBD runs.
+pub fn implicit_cantilever(hz: f32, newton: NewtonParams) -> (Solver, Vec<u32>) {
+    scheme_cantilever(hz, 1, Scheme::Newton(newton))
+}
+
+fn scheme_cantilever(hz: f32, substeps: u32, scheme: Scheme) -> (Solver, Vec<u32>) {
     let mesh = bar_mesh(BEAM_CELLS);
     let root = end_nodes(&mesh, 0.0, -1.0);
     let tip = end_nodes(&mesh, BEAM_LEN, 1.0);
     let params = SolverParams {
+        scheme,
         frame_dt: 1.0 / hz,
         substeps,
         gravity: Vec3::new(0.0, 0.0, -9.81),
