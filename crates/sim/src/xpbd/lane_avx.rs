@@ -15,6 +15,20 @@ use super::lane::{LANES, Lane};
 #[repr(transparent)]
 pub struct Avx(__m256);
 
+impl Avx {
+    /// The register (for [`super::lane_nodes`]'s loads and stores).
+    #[inline(always)]
+    pub(super) fn raw(self) -> __m256 {
+        self.0
+    }
+
+    /// Eight lanes from a register.
+    #[inline(always)]
+    pub(super) fn from_raw(v: __m256) -> Avx {
+        Avx(v)
+    }
+}
+
 /// `f` on the register, which needs AVX.
 macro_rules! avx {
     ($e:expr) => {

@@ -1,11 +1,10 @@
 //! One colour's tets projected eight at a time ([`super::rest_free_lanes`]): load a
-//! [`LaneBlock`]'s terms lane by lane, gather its tets' nodes, project, scatter the live
-//! ones back.
+//! [`LaneBlock`]'s terms lane by lane, read its tets' nodes into the lanes, project, write
+//! the live ones back ([`super::lane_nodes`]).
 
-use glam::Vec3;
-
+use super::lane_nodes::NodeLanes;
 use super::lane_slots::{LaneBlock, LaneSlots};
-use super::lanes::{LANES, Lane, M3, V3};
+use super::lanes::{LANES, M3};
 use super::rest_free_lanes::{TetLanes, project_rest_free_lanes};
 use super::shared_nodes::SharedNodes;
 
@@ -15,52 +14,28 @@ use super::shared_nodes::SharedNodes;
 /// # Safety
 /// No other thread may touch these tets' nodes during the call (colouring).
 #[inline(always)]
-unsafe fn project_block<L: Lane>(
+unsafe fn project_block<L: NodeLanes>(
     b: &LaneBlock,
     lambdas: &mut [f32],
     base: usize,
     nodes: &SharedNodes,
     inv_mass: &[f32],
 ) {
-    let mut u = [[Vec3::ZERO; LANES]; 4];
-    let mut w = [[0.0f32; LANES]; 4];
-    for k in (0..LANES).filter(|&k| b.is_live(k)) {
-        for j in 0..4 {
-            let i = b.nodes[j][k];
-            // SAFETY: the caller's contract.
-            u[j][k] = unsafe { nodes.get(i) };
-            w[j][k] = inv_mass[i as usize];
-        }
-    }
+    // SAFETY: the caller's contract.
+    let (u, w) = unsafe { L::load_nodes(b, nodes, inv_mass) };
     let mut lanes = TetLanes {
-        // Written out, not `map`: an out-of-line `map` would be compiled without the
-        // caller's AVX and call each intrinsic.
-        u: [
-            V3::gather(&u[0]),
-            V3::gather(&u[1]),
-            V3::gather(&u[2]),
-            V3::gather(&u[3]),
-        ],
-        w: [L::new(w[0]), L::new(w[1]), L::new(w[2]), L::new(w[3])],
+        u,
+        w,
         dm_inv: M3::load(&b.dm_inv),
         alpha_h: L::new(b.alpha_h),
         alpha_d: L::new(b.alpha_d),
         live: L::new(b.live),
     };
     let dl_h = project_rest_free_lanes(&mut lanes).to_array();
-    // Each position stored once, then read lane by lane.
-    let u = [
-        lanes.u[0].to_arrays(),
-        lanes.u[1].to_arrays(),
-        lanes.u[2].to_arrays(),
-        lanes.u[3].to_arrays(),
-    ];
+    // SAFETY: the caller's contract.
+    unsafe { L::store_nodes(b, &lanes.u, nodes) };
     let first = b.first as usize - base;
     for k in (0..LANES).filter(|&k| b.is_live(k)) {
-        for (j, u) in u.iter().enumerate() {
-            // SAFETY: the caller's contract.
-            unsafe { nodes.set(b.nodes[j][k], Vec3::new(u[0][k], u[1][k], u[2][k])) };
-        }
         lambdas[first + k] = dl_h[k];
     }
 }
@@ -110,7 +85,7 @@ unsafe fn project_run_avx2(
 /// # Safety
 /// As [`project_block`].
 #[inline(always)]
-unsafe fn project_blocks<L: Lane>(
+unsafe fn project_blocks<L: NodeLanes>(
     blocks: &[LaneBlock],
     lambdas: &mut [f32],
     nodes: &SharedNodes,

@@ -26,7 +26,8 @@ pub(crate) struct LaneBlock {
     pub alpha_d: [f32; LANES],
     /// All bits set in a live lane, clear otherwise (padding too).
     pub live: [f32; LANES],
-    /// `nodes[j][k]`: node j of lane k's tet (0 when padding).
+    /// `nodes[j][k]`: node j of lane k's tet (of lane 0's when padding: nodes no other
+    /// block of the colour touches, so every lane can be read, [`super::lane_nodes`]).
     pub nodes: [[u32; LANES]; 4],
     /// Slot of lane 0; lane k is slot `first + k`.
     pub first: u32,
@@ -56,6 +57,10 @@ impl LaneBlock {
                 b.nodes[j][k] = s.nodes[j];
             }
             b.set_live(k, s.live);
+        }
+        for j in 0..4 {
+            let first = b.nodes[j][0];
+            b.nodes[j][slots.len()..].fill(first);
         }
         b
     }
@@ -159,7 +164,7 @@ mod tests {
     }
 
     /// Each span is whole blocks, lane k of a block is slot `first + k` value by value,
-    /// padding lanes are identity and not live, and `set_live` reaches the right lane.
+    /// padding lanes are identity, not live and name lane 0's nodes, and `set_live` reaches the right lane.
     #[test]
     fn spans_pack_into_blocks_lane_by_lane() {
         let slots: Vec<TetSlot> = (0..30).map(slot).collect();
@@ -175,6 +180,7 @@ mod tests {
                 else {
                     assert!(!b.is_live(k));
                     assert_eq!(b.dm_inv.map(|e| e[k]), Mat3::IDENTITY.to_cols_array());
+                    assert_eq!(b.nodes.map(|j| j[k]), b.nodes.map(|j| j[0]));
                     continue;
                 };
                 assert_eq!(b.nodes.map(|j| j[k]), s.nodes);

@@ -23,6 +23,16 @@ impl SharedNodes {
         }
     }
 
+    /// Number of nodes.
+    pub(super) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// The first node's address (reads and writes through it follow the colouring too).
+    pub(super) fn as_ptr(&self) -> *mut Vec3 {
+        self.ptr
+    }
+
     /// Read node `i`.
     ///
     /// # Safety

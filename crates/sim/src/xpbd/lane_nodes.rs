@@ -1,0 +1,347 @@
+//! A block's node values into and out of the lanes (issue 35, item 3): the four nodes'
+//! displacements and inverse masses of eight tets read into lane registers before the
+//! projection, and the displacements written back after it.
+//!
+//! The generic way reads lane by lane into arrays and loads those; the AVX one reads each
+//! node's `x, y` as one 8-byte load and `z` as one 4-byte load and transposes in registers
+//! (no store of eight scalars followed by one wide load, which the CPU cannot forward, and
+//! no branch per lane), then writes back through two unpacks. Both give every lane the
+//! same bits, so the projection's results do not depend on which runs.
+//!
+//! Every lane of a block is read, padding included: a padding lane names its block's first
+//! tet's nodes ([`LaneBlock`]), which belong to this block alone within its colour, as a
+//! tet that is not live keeps its own; lanes that are not live are then zeroed, as the
+//! generic way leaves them. Only live lanes are written.
+
+use glam::Vec3;
+
+use super::lane_slots::LaneBlock;
+use super::lanes::{LANES, Lane, V3};
+use super::shared_nodes::SharedNodes;
+
+/// A lane type's way of reading and writing a block's nodes.
+pub(super) trait NodeLanes: Lane {
+    /// Lane k of `u[j]` and `w[j]`: node j of lane k's tet, displacement and inverse mass
+    /// (zero where lane k is not live).
+    ///
+    /// # Safety
+    /// No other thread may write these nodes during the call (colouring).
+    #[inline(always)]
+    unsafe fn load_nodes(
+        b: &LaneBlock,
+        nodes: &SharedNodes,
+        inv_mass: &[f32],
+    ) -> ([V3<Self>; 4], [Self; 4]) {
+        let mut u = [[Vec3::ZERO; LANES]; 4];
+        let mut w = [[0.0f32; LANES]; 4];
+        for k in (0..LANES).filter(|&k| b.is_live(k)) {
+            for j in 0..4 {
+                let i = b.nodes[j][k];
+                // SAFETY: the caller's contract.
+                u[j][k] = unsafe { nodes.get(i) };
+                w[j][k] = inv_mass[i as usize];
+            }
+        }
+        // Written out, not `map`: an out-of-line `map` would be compiled without the
+        // caller's AVX and call each intrinsic.
+        (
+            [
+                V3::gather(&u[0]),
+                V3::gather(&u[1]),
+                V3::gather(&u[2]),
+                V3::gather(&u[3]),
+            ],
+            [
+                Self::new(w[0]),
+                Self::new(w[1]),
+                Self::new(w[2]),
+                Self::new(w[3]),
+            ],
+        )
+    }
+
+    /// Write lane k of `u[j]` to node j of lane k's tet, for each live lane k.
+    ///
+    /// # Safety
+    /// No other thread may read or write these nodes during the call (colouring).
+    #[inline(always)]
+    unsafe fn store_nodes(b: &LaneBlock, u: &[V3<Self>; 4], nodes: &SharedNodes) {
+        // Each position stored once, then read lane by lane.
+        let u = [
+            u[0].to_arrays(),
+            u[1].to_arrays(),
+            u[2].to_arrays(),
+            u[3].to_arrays(),
+        ];
+        for k in (0..LANES).filter(|&k| b.is_live(k)) {
+            for (j, u) in u.iter().enumerate() {
+                // SAFETY: the caller's contract.
+                unsafe { nodes.set(b.nodes[j][k], Vec3::new(u[0][k], u[1][k], u[2][k])) };
+            }
+        }
+    }
+}
+
+impl NodeLanes for wide::f32x8 {}
+
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use std::arch::x86_64::*;
+
+    use super::super::lane_avx::Avx;
+    use super::*;
+
+    /// Lanes `[v[i0], …, v[i7]]` of `v` at the eight indices, each times `stride`, plus
+    /// `offset`: eight 4-byte loads put together in registers. (No closure here or below
+    /// calls an intrinsic: a closure is compiled without the caller's AVX and would call
+    /// each one.)
+    ///
+    /// # Safety
+    /// Every `stride × i + offset` is in bounds of `v`'s allocation; AVX2 is present.
+    #[inline(always)]
+    unsafe fn scalars(v: *const f32, idx: &[u32; LANES], stride: usize, offset: usize) -> __m256 {
+        let at = |k: usize| stride * idx[k] as usize + offset;
+        // SAFETY: the caller's contract.
+        unsafe {
+            let q0 = _mm_movelh_ps(
+                _mm_unpacklo_ps(_mm_load_ss(v.add(at(0))), _mm_load_ss(v.add(at(1)))),
+                _mm_unpacklo_ps(_mm_load_ss(v.add(at(2))), _mm_load_ss(v.add(at(3)))),
+            );
+            let q1 = _mm_movelh_ps(
+                _mm_unpacklo_ps(_mm_load_ss(v.add(at(4))), _mm_load_ss(v.add(at(5)))),
+                _mm_unpacklo_ps(_mm_load_ss(v.add(at(6))), _mm_load_ss(v.add(at(7)))),
+            );
+            _mm256_set_m128(q1, q0)
+        }
+    }
+
+    /// `[x, y, 0, 0]` of the node at `p`, one 8-byte load.
+    ///
+    /// # Safety
+    /// `p` and `p + 1` are in bounds; AVX2 is present.
+    #[inline(always)]
+    unsafe fn xy(p: *const f32) -> __m128i {
+        // SAFETY: the caller's contract.
+        unsafe { _mm_cvtsi64_si128((p as *const i64).read_unaligned()) }
+    }
+
+    /// `[x, y, x', y']` of the nodes at `p` and `q`.
+    ///
+    /// # Safety
+    /// As [`xy`], for both.
+    #[inline(always)]
+    unsafe fn xy_pair(p: *const f32, q: *const f32) -> __m128 {
+        // SAFETY: the caller's contract.
+        unsafe { _mm_castsi128_ps(_mm_unpacklo_epi64(xy(p), xy(q))) }
+    }
+
+    /// The displacements of the nodes at the eight indices, lane by lane.
+    ///
+    /// # Safety
+    /// Every index is a node of `base`'s array; AVX2 is present.
+    #[inline(always)]
+    unsafe fn positions(base: *const f32, idx: &[u32; LANES]) -> [__m256; 3] {
+        // SAFETY: the caller's contract.
+        unsafe {
+            let at = |k: usize| base.add(3 * idx[k] as usize);
+            // [x0 y0 x1 y1 | x4 y4 x5 y5] and [x2 y2 x3 y3 | x6 y6 x7 y7].
+            let lo = _mm256_set_m128(xy_pair(at(4), at(5)), xy_pair(at(0), at(1)));
+            let hi = _mm256_set_m128(xy_pair(at(6), at(7)), xy_pair(at(2), at(3)));
+            [
+                _mm256_shuffle_ps::<0x88>(lo, hi),
+                _mm256_shuffle_ps::<0xDD>(lo, hi),
+                scalars(base, idx, 3, 2),
+            ]
+        }
+    }
+
+    /// One node row of the block: displacements and inverse masses, zero where `live` is
+    /// clear.
+    ///
+    /// # Safety
+    /// As [`positions`]; `inv_mass` holds every index.
+    #[inline(always)]
+    unsafe fn read_node(
+        base: *const f32,
+        inv_mass: &[f32],
+        idx: &[u32; LANES],
+        live: Avx,
+    ) -> (V3<Avx>, Avx) {
+        // SAFETY: the caller's contract.
+        let ([x, y, z], w) =
+            unsafe { (positions(base, idx), scalars(inv_mass.as_ptr(), idx, 1, 0)) };
+        let x = Avx::from_raw(x) & live;
+        let y = Avx::from_raw(y) & live;
+        let z = Avx::from_raw(z) & live;
+        (V3 { x, y, z }, Avx::from_raw(w) & live)
+    }
+
+    /// Whether every index of the block is below `len`.
+    #[inline(always)]
+    fn in_bounds(b: &LaneBlock, len: usize) -> bool {
+        if len == 0 || len > i32::MAX as usize {
+            return len != 0 && b.nodes.iter().flatten().all(|&i| (i as usize) < len);
+        }
+        // SAFETY: AVX2 is present (an `Avx` exists); `nodes[j]` is eight u32.
+        unsafe {
+            let last = _mm256_set1_epi32(len as i32 - 1);
+            let mut top = _mm256_setzero_si256();
+            for row in &b.nodes {
+                top = _mm256_max_epu32(top, _mm256_loadu_si256(row.as_ptr() as *const __m256i));
+            }
+            _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_max_epu32(top, last), last)) == -1
+        }
+    }
+
+    impl NodeLanes for Avx {
+        #[inline(always)]
+        unsafe fn load_nodes(
+            b: &LaneBlock,
+            nodes: &SharedNodes,
+            inv_mass: &[f32],
+        ) -> ([V3<Avx>; 4], [Avx; 4]) {
+            assert!(
+                in_bounds(b, nodes.len().min(inv_mass.len())),
+                "a lane block names a node past the mesh's"
+            );
+            let base = nodes.as_ptr() as *const f32;
+            let live = Avx::new(b.live);
+            // SAFETY: every index is in bounds (checked); AVX2 is present; the nodes are
+            // this thread's (the caller's contract).
+            unsafe {
+                let r0 = read_node(base, inv_mass, &b.nodes[0], live);
+                let r1 = read_node(base, inv_mass, &b.nodes[1], live);
+                let r2 = read_node(base, inv_mass, &b.nodes[2], live);
+                let r3 = read_node(base, inv_mass, &b.nodes[3], live);
+                ([r0.0, r1.0, r2.0, r3.0], [r0.1, r1.1, r2.1, r3.1])
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn store_nodes(b: &LaneBlock, u: &[V3<Avx>; 4], nodes: &SharedNodes) {
+            assert!(
+                in_bounds(b, nodes.len()),
+                "a lane block names a node past the mesh's"
+            );
+            let base = nodes.as_ptr() as *mut f32;
+            // SAFETY: in bounds (checked); AVX2 is present; the nodes are this thread's.
+            unsafe {
+                let live = _mm256_movemask_ps(Avx::new(b.live).raw());
+                for (j, u) in u.iter().enumerate() {
+                    let (x, y) = (u.x.raw(), u.y.raw());
+                    // [x0 y0 x1 y1 | x4 y4 x5 y5] and [x2 y2 x3 y3 | x6 y6 x7 y7], as pairs.
+                    let lo: [i64; 4] = std::mem::transmute(_mm256_unpacklo_ps(x, y));
+                    let hi: [i64; 4] = std::mem::transmute(_mm256_unpackhi_ps(x, y));
+                    let xy = [lo[0], lo[1], hi[0], hi[1], lo[2], lo[3], hi[2], hi[3]];
+                    let z = u.z.to_array();
+                    for k in (0..LANES).filter(|&k| live & (1 << k) != 0) {
+                        let p = base.add(3 * b.nodes[j][k] as usize);
+                        (p as *mut i64).write_unaligned(xy[k]);
+                        p.add(2).write(z[k]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::xpbd::lane_slots::LaneSlots;
+    use crate::xpbd::neo_hookean::TetTerms;
+    use crate::xpbd::tet_slot::TetSlot;
+
+    /// Eleven tets on disjoint nodes (two blocks, the second with five padding lanes),
+    /// tets 2 and 9 not live.
+    fn blocks() -> LaneSlots {
+        let slots: Vec<TetSlot> = (0..11u32)
+            .map(|s| TetSlot {
+                nodes: [4 * s, 4 * s + 1, 4 * s + 2, 4 * s + 3],
+                terms: TetTerms {
+                    dm_inv: glam::Mat3::IDENTITY,
+                    alpha_h: 1.0,
+                    alpha_d: 1.0,
+                    gamma: 1.0,
+                },
+                live: s != 2 && s != 9,
+            })
+            .collect();
+        LaneSlots::new(&slots, std::iter::once(0..11))
+    }
+
+    /// Node i's displacement and inverse mass, telling nodes apart.
+    fn node(i: usize) -> (Vec3, f32) {
+        let f = i as f32;
+        (
+            Vec3::new(f + 0.25, -2.0 * f, 0.5 * f - 7.0),
+            1.0 / (1.0 + f),
+        )
+    }
+
+    /// What a round trip read and left: the bits of every lane read (displacements, then
+    /// inverse masses, block by block) and of the nodes after.
+    struct RoundTrip {
+        read: Vec<u32>,
+        nodes: Vec<[u32; 3]>,
+    }
+
+    /// Read every block, move each lane by its own offset, write it back.
+    fn round_trip<L: NodeLanes>() -> RoundTrip {
+        let slots = blocks();
+        let mut x: Vec<Vec3> = (0..48).map(|i| node(i).0).collect();
+        let w: Vec<f32> = (0..48).map(|i| node(i).1).collect();
+        let shared = SharedNodes::new(&mut x);
+        let mut read = Vec::new();
+        for b in &slots.blocks {
+            // SAFETY: one thread.
+            let (u, m) = unsafe { L::load_nodes(b, &shared, &w) };
+            for u in &u {
+                read.extend(u.to_arrays().iter().flatten().map(|f| f.to_bits()));
+            }
+            for m in &m {
+                read.extend(m.to_array().map(f32::to_bits));
+            }
+            let step = L::new(std::array::from_fn(|k| 100.0 * (k + 1) as f32));
+            let moved = u.map(|u| V3 {
+                x: u.x + step,
+                y: u.y - step,
+                z: u.z * L::splat(2.0),
+            });
+            // SAFETY: one thread.
+            unsafe { L::store_nodes(b, &moved, &shared) };
+        }
+        let nodes = x.iter().map(|p| p.to_array().map(f32::to_bits)).collect();
+        RoundTrip { read, nodes }
+    }
+
+    /// The AVX way reads the same bits into every lane as the generic one (zero where a
+    /// lane is not live), and writes the live lanes' nodes alone: the dead tets' and the
+    /// padding lanes' (which name the block's first tet's nodes) stay as they were.
+    #[test]
+    fn avx_reads_and_writes_what_the_generic_way_does() {
+        let generic = round_trip::<wide::f32x8>();
+        for s in 0..11usize {
+            for j in 0..4 {
+                let i = 4 * s + j;
+                let at_rest = node(i).0.to_array().map(f32::to_bits);
+                if s == 2 || s == 9 {
+                    assert_eq!(generic.nodes[i], at_rest, "dead tet {s} node {i} written");
+                } else {
+                    assert_ne!(
+                        generic.nodes[i], at_rest,
+                        "live tet {s} node {i} not written"
+                    );
+                }
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            let avx = round_trip::<super::super::lane_avx::Avx>();
+            assert_eq!(avx.read, generic.read, "lanes read");
+            assert_eq!(avx.nodes, generic.nodes, "nodes after the round trip");
+        }
+    }
+}
