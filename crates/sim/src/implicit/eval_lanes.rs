@@ -9,9 +9,10 @@
 
 use glam::{Mat3, Vec3};
 
-use super::product_lanes::{RestLanes, TangentLanes};
+use super::product_lanes::{RestLanes, TangentLanes, corners};
 use crate::material::Lame;
-use crate::xpbd::lanes::{LANES, Lane, M3, V3};
+use crate::xpbd::lane_nodes::NodeLanes;
+use crate::xpbd::lanes::{LANES, Lane, M3};
 use crate::xpbd::rest_free_lanes::{StrainLanes, log_volume, log1p_excess, shape_energy};
 
 /// Eight tets' evaluation: nodal forces, the upper triangles of the diagonal blocks
@@ -134,22 +135,16 @@ struct Deformation<L> {
 
 /// The chunk's strains at `u` (PHYSICS.md §1.2: `F = I + Du Dm⁻¹`).
 #[inline(always)]
-fn deformation<L: Lane>(rest: &RestLanes, live: &[bool], u: &[Vec3]) -> Deformation<L> {
-    let mut d = [[Vec3::ZERO; LANES]; 4];
+fn deformation<L: NodeLanes>(rest: &RestLanes, live: &[bool], u: &[Vec3]) -> Deformation<L> {
     let mut mask = [0.0f32; LANES];
-    for k in 0..rest.count {
-        for a in 0..4 {
-            d[a][k] = u[rest.nodes[k][a] as usize];
-        }
-        if live[k] {
-            mask[k] = f32::from_bits(u32::MAX);
-        }
+    for k in (0..rest.count).filter(|&k| live[k]) {
+        mask[k] = f32::from_bits(u32::MAX);
     }
-    let d0 = V3::<L>::gather(&d[0]);
+    let [d0, d1, d2, d3] = corners::<L>(rest, u);
     let du = M3 {
-        c0: V3::gather(&d[1]) - d0,
-        c1: V3::gather(&d[2]) - d0,
-        c2: V3::gather(&d[3]) - d0,
+        c0: d1 - d0,
+        c1: d2 - d0,
+        c2: d3 - d0,
     };
     let s = StrainLanes::of(du.mul_mat(&M3::load(&rest.dm_inv)));
     let excess = log1p_excess(s.j1);
@@ -175,7 +170,7 @@ fn energies<L: Lane>(d: &Deformation<L>, psi: L, volume: L, lame: Lame) -> L {
 
 /// The chunk's energies in lanes of type `L`.
 #[inline(always)]
-fn energy_in<L: Lane>(
+fn energy_in<L: NodeLanes>(
     rest: &RestLanes,
     live: &[bool],
     u: &[Vec3],
@@ -192,7 +187,7 @@ fn energy_in<L: Lane>(
 // PHYSICS.md §1.2 (the rest-free pair's energy); docs/physics-notes.md, "The implicit
 // scheme" (the tangent and the diagonal blocks).
 #[inline(always)]
-fn evaluate_in<L: Lane>(
+fn evaluate_in<L: NodeLanes>(
     rest: &RestLanes,
     live: &[bool],
     u: &[Vec3],

@@ -9,7 +9,8 @@ use glam::{Mat3, Vec3, Vec3A};
 
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
-use crate::xpbd::lanes::{LANES, Lane, M3, V3, store_mat, store_vec};
+use crate::xpbd::lane_nodes::NodeLanes;
+use crate::xpbd::lanes::{LANES, M3, V3, store_mat, store_vec};
 
 /// Eight tets' rest data: nodes, `Dm⁻¹` and `V b_a` for a = 1, 2, 3 (lanes past `count`
 /// are padding). Matrices and vectors are stored entry by entry across the lanes, so
@@ -126,7 +127,7 @@ unsafe fn product_avx2(
 /// then read lane by lane (a transpose in shuffles was no faster: 0.50 against 0.45 ms
 /// serial on the intestine).
 #[inline(always)]
-fn product_in<L: Lane>(
+fn product_in<L: NodeLanes>(
     rest: &RestLanes,
     tan: &TangentLanes,
     live: &[bool],
@@ -147,21 +148,28 @@ fn product_in<L: Lane>(
     }
 }
 
+/// `p` at the chunk's four corners, lane by lane (zero in padding lanes).
+#[inline(always)]
+pub(super) fn corners<L: NodeLanes>(rest: &RestLanes, p: &[Vec3]) -> [V3<L>; 4] {
+    let corner = |a: usize| -> [u32; LANES] { std::array::from_fn(|k| rest.nodes[k][a]) };
+    // Written out, not `map` (see forces_in).
+    [
+        L::read_vec3s(p, &corner(0), rest.count),
+        L::read_vec3s(p, &corner(1), rest.count),
+        L::read_vec3s(p, &corner(2), rest.count),
+        L::read_vec3s(p, &corner(3), rest.count),
+    ]
+}
+
 /// The chunk's four nodal forces per lane in lanes of type `L`, compiled into its caller
 /// (loops written out: an out-of-line closure would be compiled without the caller's AVX).
 #[inline(always)]
-fn forces_in<L: Lane>(rest: &RestLanes, tan: &TangentLanes, p: &[Vec3]) -> [V3<L>; 4] {
-    let mut d = [[Vec3::ZERO; LANES]; 4];
-    for k in 0..rest.count {
-        for a in 0..4 {
-            d[a][k] = p[rest.nodes[k][a] as usize];
-        }
-    }
-    let d0 = V3::<L>::gather(&d[0]);
+fn forces_in<L: NodeLanes>(rest: &RestLanes, tan: &TangentLanes, p: &[Vec3]) -> [V3<L>; 4] {
+    let [d0, d1, d2, d3] = corners::<L>(rest, p);
     let ds = M3 {
-        c0: V3::gather(&d[1]) - d0,
-        c1: V3::gather(&d[2]) - d0,
-        c2: V3::gather(&d[3]) - d0,
+        c0: d1 - d0,
+        c1: d2 - d0,
+        c2: d3 - d0,
     };
     let df = ds.mul_mat(&M3::load(&rest.dm_inv));
     let (f, cof) = (M3::<L>::load(&tan.f), M3::<L>::load(&tan.cof));

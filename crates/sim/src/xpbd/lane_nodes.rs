@@ -20,7 +20,20 @@ use super::lanes::{LANES, Lane, V3};
 use super::shared_nodes::SharedNodes;
 
 /// A lane type's way of reading and writing a block's nodes.
-pub(super) trait NodeLanes: Lane {
+pub(crate) trait NodeLanes: Lane {
+    /// Lane k is `v[idx[k]]` for k < `count`, zero past it (an index past `v` panics;
+    /// the indices past `count` are read too, so they must name nodes of `v`).
+    #[inline(always)]
+    fn read_vec3s(v: &[Vec3], idx: &[u32; LANES], count: usize) -> V3<Self> {
+        V3::gather(&std::array::from_fn(|k| {
+            if k < count {
+                v[idx[k] as usize]
+            } else {
+                Vec3::ZERO
+            }
+        }))
+    }
+
     /// Lane k of `u[j]` and `w[j]`: node j of lane k's tet, displacement and inverse mass
     /// (zero where lane k is not live).
     ///
@@ -176,24 +189,55 @@ mod avx {
         (V3 { x, y, z }, Avx::from_raw(w) & live)
     }
 
-    /// Whether every index of the block is below `len`.
+    /// Whether every index of the rows is below `len`.
     #[inline(always)]
-    fn in_bounds(b: &LaneBlock, len: usize) -> bool {
+    fn rows_below(rows: &[[u32; LANES]], len: usize) -> bool {
         if len == 0 || len > i32::MAX as usize {
-            return len != 0 && b.nodes.iter().flatten().all(|&i| (i as usize) < len);
+            return len != 0 && rows.iter().flatten().all(|&i| (i as usize) < len);
         }
-        // SAFETY: AVX2 is present (an `Avx` exists); `nodes[j]` is eight u32.
+        // SAFETY: AVX2 is present (an `Avx` exists); a row is eight u32.
         unsafe {
             let last = _mm256_set1_epi32(len as i32 - 1);
             let mut top = _mm256_setzero_si256();
-            for row in &b.nodes {
+            for row in rows {
                 top = _mm256_max_epu32(top, _mm256_loadu_si256(row.as_ptr() as *const __m256i));
             }
             _mm256_movemask_epi8(_mm256_cmpeq_epi32(_mm256_max_epu32(top, last), last)) == -1
         }
     }
 
+    /// Whether every index of the block is below `len`.
+    #[inline(always)]
+    fn in_bounds(b: &LaneBlock, len: usize) -> bool {
+        rows_below(&b.nodes, len)
+    }
+
+    /// Whether every index of `idx` is below `len`.
+    #[inline(always)]
+    fn indices_below(idx: &[u32; LANES], len: usize) -> bool {
+        rows_below(std::slice::from_ref(idx), len)
+    }
+
     impl NodeLanes for Avx {
+        #[inline(always)]
+        fn read_vec3s(v: &[Vec3], idx: &[u32; LANES], count: usize) -> V3<Avx> {
+            assert!(
+                indices_below(idx, v.len()),
+                "a node index past the mesh's {} nodes",
+                v.len()
+            );
+            // SAFETY: every index is in bounds (checked); AVX2 is present.
+            let [x, y, z] = unsafe { positions(v.as_ptr() as *const f32, idx) };
+            let on = Avx::new(std::array::from_fn(|k| {
+                f32::from_bits(if k < count { u32::MAX } else { 0 })
+            }));
+            V3 {
+                x: Avx::from_raw(x) & on,
+                y: Avx::from_raw(y) & on,
+                z: Avx::from_raw(z) & on,
+            }
+        }
+
         #[inline(always)]
         unsafe fn load_nodes(
             b: &LaneBlock,
@@ -342,6 +386,43 @@ mod tests {
             let avx = round_trip::<super::super::lane_avx::Avx>();
             assert_eq!(avx.read, generic.read, "lanes read");
             assert_eq!(avx.nodes, generic.nodes, "nodes after the round trip");
+        }
+    }
+
+    /// A slice read by indices (the implicit scheme's lanes): lane k is node `idx[k]` up
+    /// to `count`, zero past it, the same bits either way; an index past the slice is
+    /// refused by both.
+    #[test]
+    fn a_slice_reads_the_same_by_either_way() {
+        let v: Vec<Vec3> = (0..48).map(|i| node(i).0).collect();
+        let idx = [47, 3, 3, 0, 20, 1, 1, 1];
+        let bits = |u: [[f32; LANES]; 3]| u.map(|c| c.map(f32::to_bits));
+        let generic = bits(wide::f32x8::read_vec3s(&v, &idx, 5).to_arrays());
+        for k in 0..LANES {
+            let want = if k < 5 {
+                v[idx[k] as usize]
+            } else {
+                Vec3::ZERO
+            };
+            assert_eq!(
+                [0, 1, 2].map(|c| generic[c][k]),
+                want.to_array().map(f32::to_bits)
+            );
+        }
+        let past = [0, 1, 2, 48, 4, 5, 6, 7];
+        let refused = |f: fn(&[Vec3], &[u32; LANES])| {
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(&v, &past))).is_err()
+        };
+        assert!(refused(|v, i| {
+            wide::f32x8::read_vec3s(v, i, LANES);
+        }));
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            use super::super::lane_avx::Avx;
+            assert_eq!(bits(Avx::read_vec3s(&v, &idx, 5).to_arrays()), generic);
+            assert!(refused(|v, i| {
+                Avx::read_vec3s(v, i, LANES);
+            }));
         }
     }
 }

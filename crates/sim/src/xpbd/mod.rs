@@ -7,7 +7,7 @@ mod implicit_step;
 mod lane;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod lane_avx;
-mod lane_nodes;
+pub(crate) mod lane_nodes;
 mod lane_pass;
 mod lane_slots;
 pub(crate) mod lanes;

@@ -6,7 +6,7 @@ use glam::Vec3;
 ///
 /// Sound only under graph colouring: within one colour no two tets share a node, so every
 /// node is touched by at most one thread per colour pass (PHYSICS.md §1.2, parallel form).
-pub(super) struct SharedNodes {
+pub(crate) struct SharedNodes {
     ptr: *mut Vec3,
     len: usize,
 }
