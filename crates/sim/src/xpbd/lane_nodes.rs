@@ -1,6 +1,7 @@
-//! A block's node values into and out of the lanes (issue 35, item 3): the four nodes'
+//! Node values into and out of the lanes (issue 35, item 3): an XPBD block's four nodes'
 //! displacements and inverse masses of eight tets read into lane registers before the
-//! projection, and the displacements written back after it.
+//! projection and the displacements written back after it; and any eight nodes of a slice
+//! read by index (`read_vec3s`: the implicit scheme's tet evaluation and product).
 //!
 //! The generic way reads lane by lane into arrays and loads those; the AVX one reads each
 //! node's `x, y` as one 8-byte load and `z` as one 4-byte load and transposes in registers
