@@ -138,6 +138,19 @@ fn run_solver_beam(s: &mut incise_sim::Solver, tip: &[u32], hz: f32) -> (Option<
     (sag.is_finite().then_some(sag), median(&mut ms))
 }
 
+/// A cantilever row: `lead` (scene, substeps and iterations columns), stable and the sag
+/// against the reference `r` (m), or not stable, and ms a frame.
+fn print_beam_row(lead: &str, sag: Option<f32>, r: f32, ms: f64) {
+    match sag {
+        Some(v) => println!(
+            "| {lead} | yes | {:.3} cm | {:+.1} % | {ms:.1} |",
+            v * 100.0,
+            (v / r - 1.0) * 100.0
+        ),
+        None => println!("| {lead} | **no** | – | – | {ms:.1} |"),
+    }
+}
+
 /// `‖a − b‖ / ‖b‖` of two per-tet fields.
 fn field_error(a: &[f32], b: &[f32]) -> f32 {
     let d: f64 = a.iter().zip(b).map(|(x, y)| ((x - y) as f64).powi(2)).sum();
@@ -190,7 +203,11 @@ fn main() {
             let mut p = None;
             if scenes.contains("beam") || scenes.contains("implicit") {
                 let (mut s, tip) = xpbd_cantilever(hz, xpbd_sub);
-                b = run_solver_beam(&mut s, &tip, hz).0;
+                b = Some(
+                    run_solver_beam(&mut s, &tip, hz)
+                        .0
+                        .expect("XPBD reference runs"),
+                );
             }
             if scenes.contains("pull") {
                 let mut s = xpbd_pull(hz, xpbd_sub);
@@ -261,16 +278,12 @@ fn main() {
         let r = beam_ref.expect("the implicit rows run the XPBD reference");
         let (mut s, tip) = implicit_cantilever(hz, newton);
         let (sag, ms) = run_solver_beam(&mut s, &tip, hz);
-        match sag {
-            Some(v) => println!(
-                "| cantilever, implicit Euler ({name}) | – | – | yes | {:.3} cm | {:+.1} % | {ms:.1} |",
-                v * 100.0,
-                (v / r - 1.0) * 100.0
-            ),
-            None => println!(
-                "| cantilever, implicit Euler ({name}) | – | – | **no** | – | – | {ms:.1} |"
-            ),
-        }
+        print_beam_row(
+            &format!("cantilever, implicit Euler ({name}) | – | –"),
+            sag,
+            r,
+            ms,
+        );
     }
     let scenes_beam = scenes.contains("beam");
     for (sub, it) in grid() {
@@ -279,14 +292,7 @@ fn main() {
             tune(&mut p);
             let (mut s, tip) = vbd_cantilever(p);
             let (sag, ms) = run_vbd_beam(&mut s, &tip, hz);
-            match sag {
-                Some(v) => println!(
-                    "| cantilever | {sub} | {it} | yes | {:.3} cm | {:+.1} % | {ms:.1} |",
-                    v * 100.0,
-                    (v / r - 1.0) * 100.0
-                ),
-                None => println!("| cantilever | {sub} | {it} | **no** | – | – | {ms:.1} |"),
-            }
+            print_beam_row(&format!("cantilever | {sub} | {it}"), sag, r, ms);
         }
         if let Some(r) = pull_ref {
             let mut p = vbd_params(hz, sub, it, false, 1.0);
