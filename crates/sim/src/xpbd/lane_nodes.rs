@@ -207,23 +207,11 @@ mod avx {
         }
     }
 
-    /// Whether every index of the block is below `len`.
-    #[inline(always)]
-    fn in_bounds(b: &LaneBlock, len: usize) -> bool {
-        rows_below(&b.nodes, len)
-    }
-
-    /// Whether every index of `idx` is below `len`.
-    #[inline(always)]
-    fn indices_below(idx: &[u32; LANES], len: usize) -> bool {
-        rows_below(std::slice::from_ref(idx), len)
-    }
-
     impl NodeLanes for Avx {
         #[inline(always)]
         fn read_vec3s(v: &[Vec3], idx: &[u32; LANES], count: usize) -> V3<Avx> {
             assert!(
-                indices_below(idx, v.len()),
+                rows_below(std::slice::from_ref(idx), v.len()),
                 "a node index past the mesh's {} nodes",
                 v.len()
             );
@@ -246,7 +234,7 @@ mod avx {
             inv_mass: &[f32],
         ) -> ([V3<Avx>; 4], [Avx; 4]) {
             assert!(
-                in_bounds(b, nodes.len().min(inv_mass.len())),
+                rows_below(&b.nodes, nodes.len().min(inv_mass.len())),
                 "a lane block names a node past the mesh's"
             );
             let base = nodes.as_ptr() as *const f32;
@@ -265,7 +253,7 @@ mod avx {
         #[inline(always)]
         unsafe fn store_nodes(b: &LaneBlock, u: &[V3<Avx>; 4], nodes: &SharedNodes) {
             assert!(
-                in_bounds(b, nodes.len()),
+                rows_below(&b.nodes, nodes.len()),
                 "a lane block names a node past the mesh's"
             );
             let base = nodes.as_ptr() as *mut f32;
