@@ -23,6 +23,7 @@ pub mod ron_file;
 pub mod selection;
 pub mod skin;
 pub mod stress;
+pub mod thread_team;
 pub mod vbd;
 pub mod xpbd;
 

@@ -72,7 +72,9 @@ pub struct SolverParams {
     /// Simulation time between release checks, s (`None`: once per frame, as the seed).
     /// A fixed interval makes tearing independent of the frame rate.
     pub release_interval: Option<f32>,
-    /// Worker threads for the coloured projection: 0 = all cores, 1 = serial.
+    /// Worker threads for the solver's passes: 0 = all cores, 1 = serial (the sweeps'
+    /// team takes at most one thread per core: a member that waits spinning for a core
+    /// another member holds would stall every pass).
     pub threads: usize,
     /// How the CPU projects the rest-free coupled pair: `Lanes` (default, eight tets at
     /// once in SIMD lanes) or `Scalar` (the readable reference, one tet at a time).

@@ -4,19 +4,14 @@
 
 use std::ops::Range;
 
-use rayon::prelude::*;
-
 use super::lane_pass;
-use super::lane_slots::{LaneBlock, LaneSlots};
-use super::lanes::LANES;
+use super::lane_slots::LaneSlots;
 use super::neo_hookean::{ConstraintPair, TetProjection};
 use super::shared_nodes::SharedNodes;
 use super::tet_constraint::project_tet;
 use super::tet_slot::TetSlot;
 use super::{CpuKernel, SolverParams};
-
-/// Tets per rayon task: large enough to amortise scheduling, small enough to balance.
-pub(crate) const CHUNK: usize = 256;
+use crate::thread_team::share;
 
 /// The volume multipliers, written by several tasks at once.
 pub(crate) struct SharedLambdas(*mut f32);
@@ -82,8 +77,9 @@ impl<'a> RunProjector<'a> {
         }
     }
 
-    /// Project span `k` (slots `range`, packed span `k`), in tasks of [`CHUNK`] tets on
-    /// the current pool when `parallel`, and store the volume multipliers.
+    /// Project part `p` of `parts` contiguous parts of span `k` (slots `range`, packed
+    /// span `k`), and store the volume multipliers. The parts together are the span; any
+    /// split gives the same bits, as a span's tets share no node.
     ///
     /// # Safety
     /// No other task may touch these tets' nodes or slots during the call; `range` and
@@ -94,33 +90,23 @@ impl<'a> RunProjector<'a> {
         range: Range<usize>,
         lambdas: &SharedLambdas,
         nodes: &SharedNodes,
-        parallel: bool,
+        (p, parts): (usize, usize),
     ) {
         if let Some((packed, detect)) = self.lanes {
-            let blocks = &packed.blocks[packed.spans[k].clone()];
-            // SAFETY: a colour's tets share no node and each task has its own blocks,
+            let span = packed.spans[k].clone();
+            let blocks = &packed.blocks[span.start..span.end][share(span.len(), p, parts)];
+            // SAFETY: a colour's tets share no node and each part has its own blocks,
             // whose slots are their own; the rest is the caller's contract.
-            let run = |b: &[LaneBlock]| unsafe {
-                let l = lambdas.run(LaneSlots::slot_range(b));
-                lane_pass::project_run(b, l, nodes, self.inv_mass, detect)
+            unsafe {
+                let l = lambdas.run(LaneSlots::slot_range(blocks));
+                lane_pass::project_run(blocks, l, nodes, self.inv_mass, detect)
             };
-            if parallel && blocks.len() > CHUNK / LANES {
-                blocks.par_chunks(CHUNK / LANES).for_each(run);
-            } else {
-                run(blocks);
-            }
             return;
         }
-        // SAFETY: as above, each task its own range of slots.
-        let run = |r: Range<usize>| unsafe { self.scalar(r.clone(), lambdas.run(r), nodes) };
-        if parallel && range.len() > CHUNK {
-            let starts: Vec<usize> = range.clone().step_by(CHUNK).collect();
-            starts
-                .par_iter()
-                .for_each(|&s| run(s..(s + CHUNK).min(range.end)));
-        } else {
-            run(range);
-        }
+        let mine = share(range.len(), p, parts);
+        let r = range.start + mine.start..range.start + mine.end;
+        // SAFETY: as above, each part its own range of slots.
+        unsafe { self.scalar(r.clone(), lambdas.run(r), nodes) };
     }
 
     /// Project slots `r` one by one with the scalar reference.

@@ -5,14 +5,13 @@
 use std::time::Instant;
 
 use glam::{Mat3, Quat, Vec3};
-use rayon::prelude::*;
 
 use super::coloring::greedy_tet_colors;
 use super::lane_slots::LaneSlots;
 use super::locality::TetOrder;
 use super::neo_hookean::{ConstraintPair, TetTerms, deformation_gradient_from_displacement};
 use super::release_schedule::release_checks;
-use super::run_projector::{CHUNK, RunProjector, SharedLambdas};
+use super::run_projector::{RunProjector, SharedLambdas};
 use super::shared_nodes::SharedNodes;
 use super::stability::{MAX_STIFFNESS_NUMBER, stiffness_number, substeps_needed};
 use super::sweep_plan::{SweepPlan, tet_groups};
@@ -25,7 +24,15 @@ use crate::implicit::{NewtonReport, NewtonWorkspace, Scheme};
 use crate::material::{Lame, Material};
 use crate::mesh::TetMesh;
 use crate::stress::{StressMeasure, cauchy_stress, tet_stress, von_mises};
+use crate::thread_team::{ThreadTeam, for_each_zip3};
 use crate::xpbd::{Strain, displacement_gradient};
+
+/// Tets of a colour per part the team's members claim (a colour of fewer is one part):
+/// enough to amortise a claim, few enough that the members even out.
+const TEAM_PART_TETS: usize = 128;
+
+/// Fewest nodes a part of a per-node pass (prediction, velocities) holds.
+const TEAM_PART_NODES: usize = 256;
 
 /// How a node moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,6 +107,9 @@ pub struct Solver {
     /// Coarse nodes after the last implicit step (0 under XPBD).
     pub(crate) coarse_nodes: u32,
     pub(crate) pool: Option<rayon::ThreadPool>,
+    /// The pool's threads as a team for the sweeps' passes (`thread_team.rs`): its
+    /// members wait for the next pass spinning, not asleep.
+    pub(crate) team: Option<ThreadTeam>,
     /// The implicit scheme's buffers and preconditioner, built at its first step (when
     /// the pins and grabs are known).
     pub(crate) newton: Option<NewtonWorkspace>,
@@ -174,6 +184,18 @@ impl Solver {
                     })?,
             ),
         };
+        let team = match &pool {
+            Some(p) => {
+                let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+                let size = p.current_num_threads().min(cores);
+                let team = ThreadTeam::new(size).map_err(|e| SolverError::ThreadPool {
+                    threads: size,
+                    msg: e.to_string(),
+                })?;
+                Some(team)
+            }
+            None => None,
+        };
         let n = mesh.node_count();
         let t = mesh.tet_count();
         let mut solver = Solver {
@@ -212,6 +234,7 @@ impl Solver {
             implicit_cost: Default::default(),
             coarse_nodes: 0,
             pool,
+            team,
             newton: None,
             lame,
             params,
@@ -678,34 +701,47 @@ impl Solver {
     // PHYSICS.md §1.2, small-steps loop, prediction.
     pub(crate) fn predict(&mut self, h: f32, t: f64) {
         let offsets: Vec<Vec3> = self.grabs.iter().map(|g| g.offset_at(t)).collect();
-        let g = self.params.gravity;
-        for i in 0..self.u.len() {
-            self.u_prev[i] = self.u[i];
-            match self.kind[i] {
+        let (g, kind, start) = (self.params.gravity, &self.kind, &self.start);
+        let node = |i: usize, u: &mut Vec3, u_prev: &mut Vec3, v: &mut Vec3| {
+            *u_prev = *u;
+            match kind[i] {
                 NodeKind::Free => {
-                    self.v[i] += h * g;
-                    self.u[i] += h * self.v[i];
+                    *v += h * g;
+                    *u += h * *v;
                 }
-                NodeKind::Grabbed(k) => self.u[i] = self.start[i] + offsets[k as usize],
+                NodeKind::Grabbed(k) => *u = start[i] + offsets[k as usize],
                 NodeKind::Pinned | NodeKind::Retired => {}
             }
-        }
+        };
+        let arrays = (&mut self.u[..], &mut self.u_prev[..], &mut self.v[..]);
+        for_each_zip3(self.team.as_ref(), arrays, TEAM_PART_NODES, node);
     }
 
-    /// Project every live tet of colour `c` (no two share a node).
+    /// Project every live tet of colour `c` (no two share a node), in parts shared by the
+    /// team when `parallel`.
     fn project_color(&mut self, c: usize, parallel: bool) {
         let range = self.color_ranges[c].clone();
         let packed = self.packed.as_ref();
         let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
         let nodes = SharedNodes::new(&mut self.u);
         let lambdas = SharedLambdas::new(&mut self.lambda_h);
-        // SAFETY: tets of one colour share no node; this pass is the only one. The packed
-        // spans of the coloured sweep are its colours.
-        unsafe { projector.span(c, range, &lambdas, &nodes, parallel) };
+        // A colour of few tets costs less on one thread than split.
+        let parts = match parallel && self.team.is_some() {
+            true => (range.len() / TEAM_PART_TETS).max(1),
+            false => 1,
+        };
+        // SAFETY: tets of one colour share no node, and the parts are disjoint; this pass
+        // is the only one. The packed spans of the coloured sweep are its colours.
+        let part =
+            |p: usize| unsafe { projector.span(c, range.clone(), &lambdas, &nodes, (p, parts)) };
+        match self.team.as_ref() {
+            Some(team) => team.run(parts, part),
+            None => part(0),
+        }
     }
 
     /// One sweep in the partitioned order (`xpbd/sweep_plan.rs`): phase after phase, the
-    /// phase's groups in parallel, each group's tets colour after colour.
+    /// phase's groups shared by the team, each group's tets colour after colour.
     fn project_blocks(&mut self, parallel: bool) {
         let packed = self.packed.as_ref();
         let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
@@ -718,14 +754,13 @@ impl Solver {
                 // cuts), each run's tets are of one colour, and runs are disjoint ranges
                 // of the slots. The packed spans of the partitioned sweep are its runs,
                 // group by group.
-                unsafe { projector.span(*g * colours + c, r.clone(), &lambdas, &nodes, false) };
+                unsafe { projector.span(*g * colours + c, r.clone(), &lambdas, &nodes, (0, 1)) };
             }
         };
         for phase in &plan.phases {
-            if parallel {
-                phase.par_iter().for_each(group);
-            } else {
-                phase.iter().for_each(group);
+            match self.team.as_ref().filter(|_| parallel) {
+                Some(team) => team.run(phase.len(), |p| group(&phase[p])),
+                None => phase.iter().for_each(group),
             }
         }
     }
@@ -734,14 +769,16 @@ impl Solver {
     // PHYSICS.md §1.2, small-steps loop, velocity update.
     pub(crate) fn update_velocities(&mut self, h: f32) {
         let keep = (1.0 - self.params.damping * h).max(0.0);
-        let inv_h = 1.0 / h;
-        for i in 0..self.u.len() {
-            self.v[i] = match self.kind[i] {
-                NodeKind::Free => (self.u[i] - self.u_prev[i]) * inv_h * keep,
-                NodeKind::Grabbed(_) => (self.u[i] - self.u_prev[i]) * inv_h,
+        let (inv_h, kind) = (1.0 / h, &self.kind);
+        let node = |i: usize, v: &mut Vec3, u: &mut Vec3, u_prev: &mut Vec3| {
+            *v = match kind[i] {
+                NodeKind::Free => (*u - *u_prev) * inv_h * keep,
+                NodeKind::Grabbed(_) => (*u - *u_prev) * inv_h,
                 NodeKind::Pinned | NodeKind::Retired => Vec3::ZERO,
             };
-        }
+        };
+        let arrays = (&mut self.v[..], &mut self.u[..], &mut self.u_prev[..]);
+        for_each_zip3(self.team.as_ref(), arrays, TEAM_PART_NODES, node);
     }
 
     /// Stress and det F per live tet (unless `fresh` from a check after the last
@@ -794,27 +831,14 @@ impl Solver {
             measure: self.params.stress,
             h2: self.params.substep() * self.params.substep(),
         };
-        let compute = |t: usize, out: (&mut f32, &mut f32, &mut Quat)| eval.tet(t, out);
-        if parallel {
-            self.von_mises
-                .par_iter_mut()
-                .zip(self.det_f.par_iter_mut())
-                .zip(self.rotation.par_iter_mut())
-                .enumerate()
-                .with_min_len(CHUNK)
-                .for_each(|(t, ((vm, d), r))| compute(t, (vm, d, r)));
-        } else {
-            for t in 0..self.von_mises.len() {
-                compute(
-                    t,
-                    (
-                        &mut self.von_mises[t],
-                        &mut self.det_f[t],
-                        &mut self.rotation[t],
-                    ),
-                );
-            }
-        }
+        let compute = |t: usize, vm: &mut f32, d: &mut f32, r: &mut Quat| eval.tet(t, (vm, d, r));
+        let team = self.team.as_ref().filter(|_| parallel);
+        let arrays = (
+            &mut self.von_mises[..],
+            &mut self.det_f[..],
+            &mut self.rotation[..],
+        );
+        for_each_zip3(team, arrays, TEAM_PART_TETS, compute);
     }
 
     /// Count consecutive inverted frames per live tet; error past the limit.
