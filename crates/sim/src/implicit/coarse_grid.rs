@@ -7,8 +7,8 @@
 
 use rustc_hash::FxHashMap as HashMap;
 
+use crate::thread_team::{ThreadTeam, for_each_part_of_units, part_count};
 use glam::{UVec3, Vec3, Vec3A};
-use rayon::prelude::*;
 
 pub use super::coarse_pieces::NodeWeights;
 use super::coarse_pieces::{Pieces, pieces};
@@ -69,8 +69,8 @@ impl CoarseGrid {
     /// `Pᵀ r`: fine node vectors summed onto the coarse nodes (in f32 SIMD registers, then
     /// written as f64, 3 per node, for the factor), each coarse node's sum in fine-node
     /// order (the same on any thread count).
-    pub fn restrict(&self, r: &[Vec3], out: &mut [f64], parallel: bool) {
-        let node = |(c, o): (usize, &mut [f64])| {
+    pub fn restrict(&self, r: &[Vec3], out: &mut [f64], team: Option<&ThreadTeam>) {
+        let node = |c: usize, o: &mut [f64]| {
             let range = self.transpose_offsets[c] as usize..self.transpose_offsets[c + 1] as usize;
             let mut sum = Vec3A::ZERO;
             for &(i, wk) in &self.transpose[range] {
@@ -78,14 +78,12 @@ impl CoarseGrid {
             }
             o.copy_from_slice(&[sum.x as f64, sum.y as f64, sum.z as f64]);
         };
-        if parallel {
-            out.par_chunks_mut(3)
-                .enumerate()
-                .with_min_len(self.count.div_ceil(RESTRICT_TASKS).max(1))
-                .for_each(node);
-        } else {
-            out.chunks_mut(3).enumerate().for_each(node);
-        }
+        let parts = part_count(team, self.count, self.count.div_ceil(RESTRICT_TASKS));
+        for_each_part_of_units(team, out, 3, parts, |first, mine| {
+            for (k, o) in mine.chunks_mut(3).enumerate() {
+                node(first + k, o);
+            }
+        });
     }
 
     /// Per coarse node, the range of the second list holding its fine nodes and their
@@ -104,8 +102,8 @@ impl CoarseGrid {
     }
 }
 
-/// Tasks of the parallel restriction (a few per core on the machines of the issues: each
-/// task's setup costs about what a few coarse nodes' sums do).
+/// Parts of the restriction on the team (a few per core on the machines of the issues:
+/// each part's setup costs about what a few coarse nodes' sums do).
 const RESTRICT_TASKS: usize = 4;
 
 /// `weights` (fine node → its corners) transposed: per coarse node of `count`, the range
@@ -348,7 +346,7 @@ mod tests {
             .map(|k| (k as f64 * 0.1).cos())
             .collect();
         let mut pr = vec![0.0; 3 * grid.count];
-        grid.restrict(&r, &mut pr, false);
+        grid.restrict(&r, &mut pr, None);
         let c3: Vec<Vec3A> = c
             .chunks(3)
             .map(|v| Vec3A::new(v[0] as f32, v[1] as f32, v[2] as f32))
@@ -358,7 +356,8 @@ mod tests {
             .collect();
         // In parallel: the same values.
         let mut pr2 = vec![1.0; 3 * grid.count];
-        grid.restrict(&r, &mut pr2, true);
+        let team = ThreadTeam::new(2).unwrap();
+        grid.restrict(&r, &mut pr2, Some(&team));
         assert_eq!(pr, pr2);
         // (Pᵀ r)·c == r·(P c)
         let lhs: f64 = pr.iter().zip(&c).map(|(a, b)| a * b).sum();

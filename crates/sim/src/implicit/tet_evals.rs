@@ -9,6 +9,7 @@ use super::product_lanes::{RestLanes, TangentLanes, product_add, rest_lanes, tan
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
+use crate::thread_team::{ThreadTeam, for_each_item, for_each_part, for_each_zip2, part_count};
 use crate::vbd::{energy_density, piola};
 use crate::xpbd::displacement_gradient;
 use crate::xpbd::lanes::LANES;
@@ -107,7 +108,7 @@ impl TetEvals {
         let skipped = |c: usize| skip.get(c).copied().unwrap_or(false);
         match self {
             TetEvals::Scalar(evals) => {
-                for_each(at.parallel, evals, |t, out| {
+                for_each(at.team, evals, |t, out| {
                     if !skipped(t / LANES) {
                         scalar_eval(&tets[t], &at.b[t], at, at.live[t], full, out)
                     }
@@ -118,7 +119,7 @@ impl TetEvals {
                 evals,
                 tangents,
             } => {
-                let run = |c: usize, (out, tan): (&mut EvalLanes, &mut TangentLanes)| {
+                let run = |c: usize, out: &mut EvalLanes, tan: &mut TangentLanes| {
                     if skipped(c) {
                         return;
                     }
@@ -129,14 +130,14 @@ impl TetEvals {
                         eval_lanes::energy(&rest[c], live, at.u, at.lame, out);
                     }
                 };
-                for_each_pair(at.parallel, evals, tangents, run);
+                for_each_zip2(at.team, (evals, tangents), CHUNK / LANES, run);
             }
         }
     }
 }
 
-/// Fixed ranges of the tets whose product forces are summed apart (each on a thread of
-/// its own when parallel) and then added in order, so the sums do not depend on the
+/// Fixed ranges of the tets whose product forces are summed apart (each a part of the
+/// team's pass) and then added in order, so the sums do not depend on the
 /// thread count.
 pub(super) const PRODUCT_PARTS: usize = 4;
 
@@ -179,12 +180,12 @@ impl TetEvals {
                 }
             }
         };
-        if at.parallel {
-            use rayon::prelude::*;
-            parts.par_iter_mut().enumerate().for_each(run);
-        } else {
-            parts.iter_mut().enumerate().for_each(run);
-        }
+        let count = part_count(at.team, parts.len(), 1);
+        for_each_part(at.team, parts, count, |first, mine| {
+            for (k, sums) in mine.iter_mut().enumerate() {
+                run((first + k, sums));
+            }
+        });
     }
 }
 
@@ -210,8 +211,8 @@ fn scalar_product(tet: &RestTet, b: &[Vec3; 4], tangent: &TetTangent, p: &[Vec3]
 }
 
 /// Where the tets are evaluated (or, for [`TetEvals::products`], the direction): the
-/// displacements, which tets are live, the material, the shape gradients and whether on
-/// the pool's threads.
+/// displacements, which tets are live, the material, the shape gradients and the threads
+/// the passes run on.
 #[derive(Clone, Copy)]
 pub(super) struct Iterate<'a> {
     /// Node displacements.
@@ -222,8 +223,8 @@ pub(super) struct Iterate<'a> {
     pub(super) lame: Lame,
     /// Shape gradients `b_a` per tet.
     pub(super) b: &'a [[Vec3; 4]],
-    /// On the pool's threads.
-    pub(super) parallel: bool,
+    /// The threads the passes run on (`None`: this one).
+    pub(super) team: Option<&'a ThreadTeam>,
 }
 
 /// One tet's evaluation (`full` false: its energy alone).
@@ -255,37 +256,14 @@ fn scalar_eval(
     }
 }
 
-/// Items per rayon task.
+/// Fewest items in a part of a pass on the team.
 const CHUNK: usize = 256;
 
-/// `f(i, &mut out[i])` for every item, on the pool's threads when `parallel`.
-pub(super) fn for_each<T: Send>(parallel: bool, out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {
-    use rayon::prelude::*;
-    if parallel {
-        out.par_iter_mut()
-            .enumerate()
-            .with_min_len(CHUNK)
-            .for_each(|(i, o)| f(i, o));
-    } else {
-        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
-    }
-}
-
-/// `f(i, (&mut a[i], &mut b[i]))` for every pair, on the pool's threads when `parallel`.
-fn for_each_pair<A: Send, B: Send>(
-    parallel: bool,
-    a: &mut [A],
-    b: &mut [B],
-    f: impl Fn(usize, (&mut A, &mut B)) + Sync,
+/// `f(i, &mut out[i])` for every item, on the team's threads where there is one.
+pub(super) fn for_each<T: Send>(
+    team: Option<&ThreadTeam>,
+    out: &mut [T],
+    f: impl Fn(usize, &mut T) + Sync,
 ) {
-    use rayon::prelude::*;
-    if parallel {
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .enumerate()
-            .with_min_len(CHUNK / LANES)
-            .for_each(|(i, p)| f(i, p));
-    } else {
-        a.iter_mut().zip(b).enumerate().for_each(|(i, p)| f(i, p));
-    }
+    for_each_item(team, out, CHUNK, f);
 }

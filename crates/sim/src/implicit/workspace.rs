@@ -14,7 +14,6 @@
 //! backtracking line search on `G` keeps every step a descent.
 
 use glam::{Mat3, Vec3, Vec3A};
-use rayon::prelude::*;
 
 use super::block_matrix::BlockMatrix;
 use super::coarse_level::CoarseLevel;
@@ -26,10 +25,11 @@ use super::rest_tet::RestTet;
 use super::tet_evals::{Iterate, PRODUCT_PARTS, TetEvals, active_chunks, for_each};
 use crate::material::Lame;
 use crate::mesh::TetMesh;
+use crate::thread_team::{ThreadTeam, for_each_zip2};
 use crate::vbd::shape_gradients;
 use crate::xpbd::lanes::LANES;
 
-/// Items per rayon task.
+/// Fewest nodes in a part of a node pass on the team.
 const CHUNK: usize = 256;
 /// Armijo constant of the line search.
 const ARMIJO: f64 = 1e-4;
@@ -162,23 +162,29 @@ impl NewtonWorkspace {
         y: &[Vec3],
         live: &[bool],
         free: &[bool],
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) {
         let mut report = NewtonReport::default();
         // The step's first evaluation covers every tet; the later ones skip the chunks
         // whose tets reach no free node (their nodes hold their targets all step).
         self.hessian.fixed.clear();
-        let mut g_now = self.hessian.evaluate(u, y, live, free, parallel);
+        let mut g_now = self.hessian.evaluate(u, y, live, free, team);
         self.hessian.find_active(live, free);
         if self.pre.level.refresh_due(&self.last) {
             report.coarse_refreshed = true;
-            report.coarse_refresh_failed = self.refresh_coarse(live, parallel).is_err();
+            report.coarse_refresh_failed = self.refresh_coarse(live, team.is_some()).is_err();
         }
         self.pre.level.tick();
         if let Some(m) = &mut self.pre.matrix {
             let h = &self.hessian;
             let mass = |i: usize| h.mass[i] * h.inv_h2;
-            m.assemble((&h.tets, &h.b), (&h.evals, live), mass, true, parallel);
+            m.assemble(
+                (&h.tets, &h.b),
+                (&h.evals, live),
+                mass,
+                true,
+                team.is_some(),
+            );
         }
         let mut first_norm = None;
         for _ in 0..self.params.iterations {
@@ -188,7 +194,7 @@ impl NewtonWorkspace {
                 free,
                 &mut self.gradient,
                 &mut self.pre.diag_inv,
-                parallel,
+                team,
             );
             let norm = dot(&self.gradient, &self.gradient).sqrt();
             let stop;
@@ -206,8 +212,8 @@ impl NewtonWorkspace {
                     &mut self.direction,
                     self.params.cg_iterations,
                     self.params.cg_tolerance,
-                    |p, out| hessian.apply(p, out, live, free, parallel),
-                    |r, z| pre.apply(r, z, free, parallel, smooth),
+                    |p, out| hessian.apply(p, out, live, free, team),
+                    |r, z| pre.apply(r, z, free, team, smooth),
                 )
             };
             let mut cg = solve(true);
@@ -227,7 +233,7 @@ impl NewtonWorkspace {
             if slope >= 0.0 {
                 break;
             }
-            match self.line_search(u, y, live, free, g_now, slope, parallel, &mut report) {
+            match self.line_search(u, y, live, free, g_now, slope, team, &mut report) {
                 Some((g, alpha)) => {
                     g_now = g;
                     let moved = alpha * reach(&self.direction, free);
@@ -278,7 +284,7 @@ impl NewtonWorkspace {
         free: &[bool],
         g_now: f64,
         slope: f64,
-        parallel: bool,
+        team: Option<&ThreadTeam>,
         report: &mut NewtonReport,
     ) -> Option<(f64, f32)> {
         let mut alpha = 1.0f32;
@@ -289,13 +295,13 @@ impl NewtonWorkspace {
                 *t = *u + alpha * *d;
             }
             let g_trial = if halving == 0 {
-                self.hessian.evaluate(&self.trial, y, live, free, parallel)
+                self.hessian.evaluate(&self.trial, y, live, free, team)
             } else {
-                self.hessian.energy(&self.trial, y, live, free, parallel)
+                self.hessian.energy(&self.trial, y, live, free, team)
             };
             if g_trial <= g_now + ARMIJO * alpha as f64 * slope + rounding {
                 if halving > 0 {
-                    self.hessian.evaluate(&self.trial, y, live, free, parallel);
+                    self.hessian.evaluate(&self.trial, y, live, free, team);
                 }
                 u.copy_from_slice(&self.trial);
                 return Some((g_trial, alpha));
@@ -303,7 +309,7 @@ impl NewtonWorkspace {
             alpha *= 0.5;
             report.halvings += 1;
         }
-        self.hessian.evaluate(u, y, live, free, parallel);
+        self.hessian.evaluate(u, y, live, free, team);
         None
     }
 }
@@ -328,14 +334,14 @@ impl Hessian {
         y: &[Vec3],
         live: &[bool],
         free: &[bool],
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) -> f64 {
         let at = Iterate {
             u,
             live,
             lame: self.lame,
             b: &self.b,
-            parallel,
+            team,
         };
         self.evals.evaluate(&self.tets, at, true, &self.fixed);
         self.total(u, y, free)
@@ -350,14 +356,14 @@ impl Hessian {
         y: &[Vec3],
         live: &[bool],
         free: &[bool],
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) -> f64 {
         let at = Iterate {
             u,
             live,
             lame: self.lame,
             b: &self.b,
-            parallel,
+            team,
         };
         self.evals.evaluate(&self.tets, at, false, &self.fixed);
         self.total(u, y, free)
@@ -394,7 +400,7 @@ impl Hessian {
         free: &[bool],
         gradient: &mut [Vec3],
         diag_inv: &mut [Mat3],
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) {
         let node = |i: usize, out: (&mut Vec3, &mut Mat3)| {
             if !free[i] {
@@ -406,18 +412,8 @@ impl Hessian {
             *out.0 = g;
             *out.1 = d.inverse();
         };
-        if parallel {
-            gradient
-                .par_iter_mut()
-                .zip(diag_inv.par_iter_mut())
-                .enumerate()
-                .with_min_len(CHUNK)
-                .for_each(|(i, (g, d))| node(i, (g, d)));
-        } else {
-            for (i, (g, d)) in gradient.iter_mut().zip(diag_inv.iter_mut()).enumerate() {
-                node(i, (g, d));
-            }
-        }
+        let node = |i: usize, g: &mut Vec3, d: &mut Mat3| node(i, (g, d));
+        for_each_zip2(team, (gradient, diag_inv), CHUNK, node);
     }
 
     /// Find the chunks of tets whose forces reach a free node (what [`Hessian::apply`]
@@ -438,24 +434,30 @@ impl Hessian {
         out: &mut [Vec3],
         live: &[bool],
         free: &[bool],
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) {
         let at = Iterate {
             u: p,
             live,
             lame: self.lame,
             b: &self.b,
-            parallel,
+            team,
         };
         let active = &self.active;
         self.evals
             .products(&self.tets, at, active, &mut self.product_parts);
-        self.gather_products(p, out, free, parallel);
+        self.gather_products(p, out, free, team);
     }
 
     /// `out = M/h² p +` the tets' forces at each free node, the parts added in order
     /// (zero at fixed nodes).
-    fn gather_products(&self, p: &[Vec3], out: &mut [Vec3], free: &[bool], parallel: bool) {
+    fn gather_products(
+        &self,
+        p: &[Vec3],
+        out: &mut [Vec3],
+        free: &[bool],
+        team: Option<&ThreadTeam>,
+    ) {
         let (parts, mass, inv_h2) = (&self.product_parts, &self.mass, self.inv_h2);
         let node = |i: usize, o: &mut Vec3| {
             if !free[i] {
@@ -468,7 +470,7 @@ impl Hessian {
             }
             *o = sum;
         };
-        for_each(parallel, out, node);
+        for_each(team, out, node);
     }
 
     /// The (tet, corner) pairs of node `i`.
@@ -481,9 +483,16 @@ impl TwoLevel {
     /// `z = S r + P A_c⁻¹ Pᵀ r` (additive two-level; zero at fixed nodes), `S` one
     /// symmetric Gauss–Seidel sweep where the smoother is `GaussSeidel` and `smooth`, else
     /// block Jacobi `D⁻¹`; the fine part, the prolongation and the mask in one node pass.
-    fn apply(&mut self, r: &[Vec3], z: &mut [Vec3], free: &[bool], parallel: bool, smooth: bool) {
+    fn apply(
+        &mut self,
+        r: &[Vec3],
+        z: &mut [Vec3],
+        free: &[bool],
+        team: Option<&ThreadTeam>,
+        smooth: bool,
+    ) {
         let level = &self.level;
-        level.grid.restrict(r, &mut self.rhs, parallel);
+        level.grid.restrict(r, &mut self.rhs, team);
         level.system.solve(&mut self.rhs);
         self.coarse.clear();
         self.coarse.extend(
@@ -499,7 +508,7 @@ impl TwoLevel {
             _ => false,
         };
         let (grid, coarse, diag_inv) = (&level.grid, &self.coarse, &self.diag_inv);
-        for_each(parallel, z, |i, z| {
+        for_each(team, z, |i, z| {
             *z = if !free[i] {
                 Vec3::ZERO
             } else {
@@ -591,15 +600,16 @@ mod tests {
     #[test]
     fn the_lanes_product_is_the_scalar_product() {
         let (mesh, [mut scalar, mut lanes], free) = odd_blocks();
+        let team = ThreadTeam::new(2).unwrap();
         let n = mesh.node_count();
         let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 5 != 3).collect();
         let u = wobble(n, 1e-3);
         let p = wobble(n + 5, 1.0)[5..].to_vec();
         let mut out = [vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]];
         for (ws, o) in [&mut scalar, &mut lanes].into_iter().zip(out.iter_mut()) {
-            ws.hessian.evaluate(&u, &u, &live, &free, true);
+            ws.hessian.evaluate(&u, &u, &live, &free, Some(&team));
             ws.hessian.find_active(&live, &free);
-            ws.hessian.apply(&p, o, &live, &free, true);
+            ws.hessian.apply(&p, o, &live, &free, Some(&team));
         }
         let scale = out[0].iter().map(|v| v.length()).fold(0.0, f32::max);
         let err = out[0]
@@ -620,6 +630,7 @@ mod tests {
     #[test]
     fn the_lanes_evaluation_is_the_scalar_evaluation() {
         let (mesh, [mut scalar, mut lanes], free) = odd_blocks();
+        let team = ThreadTeam::new(2).unwrap();
         let n = mesh.node_count();
         let live: Vec<bool> = (0..mesh.tet_count()).map(|t| t % 5 != 3).collect();
         // Up to 4 mm on 5 mm cells: some tets flattened past J_MIN or inverted.
@@ -632,8 +643,8 @@ mod tests {
         assert!(squashed > 0, "no tet below J_MIN");
         let mut out = Vec::new();
         for ws in [&mut scalar, &mut lanes] {
-            let g = ws.hessian.evaluate(&u, &y, &live, &free, true);
-            let e = ws.hessian.energy(&u, &y, &live, &free, true);
+            let g = ws.hessian.evaluate(&u, &y, &live, &free, Some(&team));
+            let e = ws.hessian.energy(&u, &y, &live, &free, Some(&team));
             assert_eq!(
                 g.to_bits(),
                 e.to_bits(),
@@ -641,7 +652,7 @@ mod tests {
             );
             let (mut grad, mut d) = (vec![Vec3::ZERO; n], vec![Mat3::ZERO; n]);
             ws.hessian
-                .gather_gradient(&u, &y, &free, &mut grad, &mut d, true);
+                .gather_gradient(&u, &y, &free, &mut grad, &mut d, Some(&team));
             let tangents: Vec<Mat3> = (0..mesh.tet_count())
                 .filter(|&t| live[t])
                 .map(|t| {
@@ -710,10 +721,10 @@ mod tests {
                 .map(|(w, f)| if *f { *w } else { Vec3::ZERO })
                 .collect();
             let mut assembled = |u: &[Vec3], exact: bool| {
-                ws.hessian.evaluate(u, u, &live, &free, false);
+                ws.hessian.evaluate(u, u, &live, &free, None);
                 let mut want = vec![Vec3::ZERO; n];
                 ws.hessian.find_active(&live, &free);
-                ws.hessian.apply(&p, &mut want, &live, &free, false);
+                ws.hessian.apply(&p, &mut want, &live, &free, None);
                 let h = &ws.hessian;
                 let mut m = BlockMatrix::new(n, &h.tets);
                 let mass = |i: usize| h.mass[i] * h.inv_h2;
@@ -759,14 +770,14 @@ mod tests {
         let n = mesh.node_count();
         let u = wobble(n, 1e-3);
         let p = wobble(n + 5, 1.0)[5..].to_vec();
-        ws.hessian.evaluate(&u, &u, &live, &free, false);
+        ws.hessian.evaluate(&u, &u, &live, &free, None);
         let chunks = mesh.tet_count().div_ceil(LANES);
         let mut out = [vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]];
         ws.hessian.find_active(&live, &free);
         let skipped = chunks - ws.hessian.active.len();
-        ws.hessian.apply(&p, &mut out[0], &live, &free, false);
+        ws.hessian.apply(&p, &mut out[0], &live, &free, None);
         ws.hessian.active = (0..chunks as u32).collect();
-        ws.hessian.apply(&p, &mut out[1], &live, &free, false);
+        ws.hessian.apply(&p, &mut out[1], &live, &free, None);
         assert!(
             skipped > chunks / 4,
             "only {skipped} of {chunks} chunks skipped"
@@ -793,15 +804,15 @@ mod tests {
             .collect();
         let y = wobble(n + 4, 1e-3)[4..].to_vec();
         let at_moved = |ws: &mut NewtonWorkspace| {
-            let g = ws.hessian.evaluate(&moved, &y, &live, &free, false);
-            let e = ws.hessian.energy(&moved, &y, &live, &free, false);
+            let g = ws.hessian.evaluate(&moved, &y, &live, &free, None);
+            let e = ws.hessian.energy(&moved, &y, &live, &free, None);
             let (mut grad, mut d) = (vec![Vec3::ZERO; n], vec![Mat3::ZERO; n]);
             ws.hessian
-                .gather_gradient(&moved, &y, &free, &mut grad, &mut d, false);
+                .gather_gradient(&moved, &y, &free, &mut grad, &mut d, None);
             (g.to_bits(), e.to_bits(), grad)
         };
         ws.hessian.fixed.clear();
-        ws.hessian.evaluate(&start, &y, &live, &free, false);
+        ws.hessian.evaluate(&start, &y, &live, &free, None);
         ws.hessian.find_active(&live, &free);
         assert!(
             ws.hessian.fixed.iter().filter(|f| **f).count() > 4,
@@ -842,7 +853,7 @@ mod tests {
             .collect();
         let mut solved = Vec::new();
         for ws in [&mut fresh, &mut released] {
-            ws.hessian.evaluate(&u, &u, &live, &free, false);
+            ws.hessian.evaluate(&u, &u, &live, &free, None);
             ws.refresh_coarse(&live, false).unwrap();
         }
         released.release(&[5]).unwrap();
@@ -872,9 +883,7 @@ mod tests {
         let mut live = vec![true; mesh.tet_count()];
         live[5] = false;
         live[40] = false;
-        refreshed
-            .hessian
-            .evaluate(&rest, &rest, &live, &free, false);
+        refreshed.hessian.evaluate(&rest, &rest, &live, &free, None);
         refreshed.refresh_coarse(&live, false).unwrap();
         released.release(&[5, 40]).unwrap();
         let rhs: Vec<f64> = (0..released.pre.rhs.len())
@@ -918,19 +927,19 @@ mod tests {
             .collect();
         let grad_at = |ws: &mut NewtonWorkspace, s: f32| {
             let x: Vec<Vec3> = u.iter().zip(&p).map(|(u, p)| *u + s * *p).collect();
-            ws.hessian.evaluate(&x, &y, &live, &free, false);
+            ws.hessian.evaluate(&x, &y, &live, &free, None);
             let mut g = vec![Vec3::ZERO; n];
             let mut d = vec![Mat3::ZERO; n];
             ws.hessian
-                .gather_gradient(&x, &y, &free, &mut g, &mut d, false);
+                .gather_gradient(&x, &y, &free, &mut g, &mut d, None);
             g
         };
         let eps = 1e-6;
         let (gp, gm) = (grad_at(&mut ws, eps), grad_at(&mut ws, -eps));
-        ws.hessian.evaluate(&u, &y, &live, &free, false);
+        ws.hessian.evaluate(&u, &y, &live, &free, None);
         let mut hp = vec![Vec3::ZERO; n];
         ws.hessian.find_active(&live, &free);
-        ws.hessian.apply(&p, &mut hp, &live, &free, false);
+        ws.hessian.apply(&p, &mut hp, &live, &free, None);
         let fd: Vec<Vec3> = gp
             .iter()
             .zip(&gm)

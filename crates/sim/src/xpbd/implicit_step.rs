@@ -219,7 +219,13 @@ impl Solver {
     /// not `free` held; its cost booked.
     fn implicit_solve(&mut self, y: &[Vec3], live: &[bool], free: &[bool], parallel: bool) {
         if let Some(ws) = &mut self.newton {
-            ws.solve(&mut self.u, y, live, free, parallel);
+            ws.solve(
+                &mut self.u,
+                y,
+                live,
+                free,
+                self.team.as_ref().filter(|_| parallel),
+            );
             let r = ws.last;
             self.implicit_cost.add(&r);
             self.coarse_nodes = r.coarse_nodes;
