@@ -13,6 +13,7 @@ use super::{CpuKernel, SolverError};
 use glam::Vec3;
 
 use crate::implicit::{NewtonParams, NewtonWorkspace, Scheme};
+use crate::thread_team::{for_each_part, part_count, share};
 
 /// Times a step's solve is repeated with the nodes it carried into the tool held too
 /// (docs/physics-notes.md, "The implicit scheme under a blade": one pass more brings the
@@ -205,14 +206,22 @@ impl Solver {
         for &t in gone {
             live[t as usize] = false;
         }
-        (0..self.mesh.tet_count())
-            .filter(|&t| live[t])
-            .filter(|&t| {
-                let d = self.mesh.tets[t].map(|k| self.u[k as usize]);
-                deformation_gradient_from_displacement(&d, &self.mesh.dm_inv[t]).determinant()
+        let inverted = |t: usize| {
+            let d = self.mesh.tets[t].map(|k| self.u[k as usize]);
+            live[t]
+                && deformation_gradient_from_displacement(&d, &self.mesh.dm_inv[t]).determinant()
                     <= 0.0
-            })
-            .count()
+        };
+        // Counted per part on the team, the parts' counts summed.
+        let (n, team) = (self.mesh.tet_count(), self.team.as_ref());
+        let parts = part_count(team, n, 1024);
+        let mut counts = vec![0; parts];
+        for_each_part(team, &mut counts, parts, |first, mine| {
+            for (k, count) in mine.iter_mut().enumerate() {
+                *count = share(n, first + k, parts).filter(|&t| inverted(t)).count();
+            }
+        });
+        counts.iter().sum()
     }
 
     /// One Newton solve of the step from `u` to the minimum of `G` (target `y`), the nodes
@@ -244,5 +253,68 @@ impl Solver {
             self.contact_push[i] += h * h * ws.reaction(&self.u, y, i);
             self.touched[i] = true;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::block;
+    use crate::material::Material;
+    use crate::mesh::TetMesh;
+    use crate::xpbd::SolverParams;
+
+    /// A 6,144-tet block on `threads`, every third node pushed through its neighbours.
+    fn crushed(threads: usize) -> Solver {
+        let raw = block(
+            Vec3::ZERO,
+            Vec3::new(0.08, 0.04, 0.02),
+            glam::UVec3::new(16, 8, 8),
+        );
+        let mesh = TetMesh::from_raw(raw).unwrap().0;
+        let material = Material {
+            youngs_modulus: 10e3,
+            poisson_ratio: 0.4,
+            density: 1000.0,
+        };
+        let params = SolverParams {
+            threads,
+            substeps: 40,
+            ..SolverParams::default()
+        };
+        let mut s = Solver::new(mesh, material, params).unwrap();
+        let mut x = s.positions().to_vec();
+        for (i, p) in x.iter_mut().enumerate().step_by(3) {
+            p.z -= if i % 2 == 0 { 0.004 } else { -0.004 };
+        }
+        s.set_positions(&x);
+        s
+    }
+
+    /// The count of inverted live tets is the same counted in parts on a team as on one
+    /// thread, and leaves out the tets named gone.
+    #[test]
+    fn inverted_tets_are_counted_alike_on_a_team() {
+        let (one, team) = (crushed(1), crushed(2));
+        assert!(team.team.is_some(), "two threads make a team");
+        let gone: Vec<u32> = (0..100).collect();
+        let serial = |gone: &[u32]| {
+            (0..one.mesh.tet_count() as u32)
+                .filter(|t| !gone.contains(t))
+                .filter(|&t| {
+                    let d = one.mesh.tets[t as usize].map(|k| one.u[k as usize]);
+                    let dm_inv = &one.mesh.dm_inv[t as usize];
+                    deformation_gradient_from_displacement(&d, dm_inv).determinant() <= 0.0
+                })
+                .count()
+        };
+        let (all, some) = (serial(&[]), serial(&gone));
+        assert!(
+            all > 100 && some < all,
+            "crushed: {all} inverted, {some} without the gone"
+        );
+        assert_eq!(one.inverted_live_tets(&[]), all);
+        assert_eq!(team.inverted_live_tets(&[]), all);
+        assert_eq!(team.inverted_live_tets(&gone), some);
     }
 }
