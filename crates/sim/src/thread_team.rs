@@ -3,18 +3,19 @@
 //! cache-line round trips, not a thread wake-up each).
 //!
 //! A rayon pool puts an idle worker to sleep within microseconds, and waking it costs a
-//! system call and, on a virtual machine, a halted virtual CPU brought back: 16–50 µs
-//! measured on the 2-core guest (docs/performance.md, "Two cores"), paid after every serial
-//! gap of a sweep (prediction, contacts, velocities). A team member instead waits for the
-//! next job for [`SPIN`] after each one (spinning, then yielding its core between looks),
-//! so the gaps inside a frame cost it nothing, and sleeps once the frame is over.
+//! system call and, on a virtual machine, a halted virtual CPU brought back: 16–52 µs
+//! measured on the 2-core guest (docs/performance.md, "The sweep's threads as a team"),
+//! paid after every serial gap of a sweep (prediction, contacts, velocities). A team
+//! member instead waits for the next job for [`SPIN`] after each one (spinning, then
+//! yielding its core between looks), so the gaps inside a frame cost it nothing, and
+//! sleeps once the frame is over.
 //!
 //! A job is cut into parts that do not depend on each other. Each member has a home range
 //! of them (the same data job after job, so it stays in that core's cache) and claims its
 //! parts one at a time, then any the others have not claimed: a member the system has
 //! descheduled leaves its parts to the others instead of stalling the job (as rayon's work
-//! stealing does). Which member runs a
-//! part does not change what the part computes, so results never depend on timing.
+//! stealing does). Which member runs a part does not change what the part computes, so
+//! results never depend on timing.
 
 use std::cell::UnsafeCell;
 use std::ops::Range;
