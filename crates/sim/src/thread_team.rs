@@ -216,16 +216,19 @@ pub fn for_each_part_of_units<T: Send>(
         return f(0, items);
     };
     let units = items.len() / unit;
+    let split = split_parts(items, unit, parts);
+    run_split(team, split, |p, mine| f(share(units, p, parts).start, mine));
+}
+
+/// `f(p, &mut split[p])` for each part `p`, on the members of `team`.
+fn run_split<S: Send>(team: &ThreadTeam, split: Vec<S>, f: impl Fn(usize, &mut S) + Sync) {
     // Each part is locked by the one member that claimed it: never contended.
-    let split: Vec<Mutex<&mut [T]>> = split_parts(items, unit, parts)
-        .into_iter()
-        .map(Mutex::new)
-        .collect();
-    team.run(parts, |p| {
+    let split: Vec<Mutex<S>> = split.into_iter().map(Mutex::new).collect();
+    team.run(split.len(), |p| {
         let mut mine = split[p]
             .lock()
             .expect("a part is locked by its member only");
-        f(share(units, p, parts).start, &mut mine);
+        f(p, &mut mine);
     });
 }
 
@@ -289,14 +292,9 @@ pub fn for_each_zip3<A: Send, B: Send, C: Send>(
         split_parts(b, 1, parts),
         split_parts(c, 1, parts),
     );
-    // Each part is locked by the one member that claimed it: never contended.
-    let split: Vec<Mutex<_>> = a.into_iter().zip(b).zip(c).map(Mutex::new).collect();
-    team.run(parts, |p| {
-        let mut mine = split[p]
-            .lock()
-            .expect("a part is locked by its member only");
-        let ((a, b), c) = &mut *mine;
-        run(share(len, p, parts).start, a, b, c);
+    let split: Vec<_> = a.into_iter().zip(b).zip(c).collect();
+    run_split(team, split, |p, ((a, b), c)| {
+        run(share(len, p, parts).start, a, b, c)
     });
 }
 

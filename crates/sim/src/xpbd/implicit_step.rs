@@ -13,7 +13,7 @@ use super::{CpuKernel, SolverError};
 use glam::Vec3;
 
 use crate::implicit::{NewtonParams, NewtonWorkspace, Scheme};
-use crate::thread_team::{for_each_part, part_count, share};
+use crate::thread_team::{for_each_item, part_count, share};
 
 /// Times a step's solve is repeated with the nodes it carried into the tool held too
 /// (docs/physics-notes.md, "The implicit scheme under a blade": one pass more brings the
@@ -207,19 +207,18 @@ impl Solver {
             live[t as usize] = false;
         }
         let inverted = |t: usize| {
-            let d = self.mesh.tets[t].map(|k| self.u[k as usize]);
-            live[t]
-                && deformation_gradient_from_displacement(&d, &self.mesh.dm_inv[t]).determinant()
+            live[t] && {
+                let d = self.mesh.tets[t].map(|k| self.u[k as usize]);
+                deformation_gradient_from_displacement(&d, &self.mesh.dm_inv[t]).determinant()
                     <= 0.0
-        };
-        // Counted per part on the team, the parts' counts summed.
-        let (n, team) = (self.mesh.tet_count(), self.team.as_ref());
-        let parts = part_count(team, n, 1024);
-        let mut counts = vec![0; parts];
-        for_each_part(team, &mut counts, parts, |first, mine| {
-            for (k, count) in mine.iter_mut().enumerate() {
-                *count = share(n, first + k, parts).filter(|&t| inverted(t)).count();
             }
+        };
+        // Counted per part on the team (one count a part), the parts' counts summed.
+        let (n, team) = (self.mesh.tet_count(), self.team.as_ref());
+        let mut counts = vec![0; part_count(team, n, 1024)];
+        let parts = counts.len();
+        for_each_item(team, &mut counts, 1, |p, count| {
+            *count = share(n, p, parts).filter(|&t| inverted(t)).count();
         });
         counts.iter().sum()
     }
