@@ -10,6 +10,7 @@ use super::coarse_assembly::pair_block;
 use super::product_lanes::{RestLanes, TangentLanes};
 use super::rest_tet::RestTet;
 use super::tet_evals::TetEvals;
+use crate::thread_team::{ThreadTeam, for_each_part, part_count};
 use crate::xpbd::lanes::LANES;
 
 /// A block-sparse symmetric matrix on the mesh's node graph, rows by node, columns
@@ -80,19 +81,19 @@ impl BlockMatrix {
     /// diagonal blocks, `K_t` tet t's Hessian (PHYSICS.md §1.2's energy differentiated
     /// twice, `pair_block`), with `definite` its indefinite parts cut: `c ≥ 0` and
     /// `s₃ ≥ −μ/σ̂` (σ̂ ≥ 1 a Gershgorin bound of the largest stretch; at rest nothing is
-    /// cut). Tets are summed in [`PARTS`] fixed ranges, each on its own thread when
-    /// `parallel`, then the parts in order: the result does not depend on the thread count.
+    /// cut). Tets are summed in [`PARTS`] fixed ranges, shared by the members of `team`,
+    /// then the parts in order: the result does not depend on the thread count.
     pub fn assemble(
         &mut self,
         (tets, b): (&[RestTet], &[[Vec3; 4]]),
         (evals, live): (&TetEvals, &[bool]),
         mass_over_h2: impl Fn(usize) -> f32,
         definite: bool,
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) {
         let mut parts = std::mem::take(&mut self.parts);
         parts.resize_with(PARTS, Vec::new);
-        let sum_part = |(k, out): (usize, &mut Vec<Mat3>)| {
+        let sum_part = |k: usize, out: &mut Vec<Mat3>| {
             out.clear();
             out.resize(self.cols.len(), Mat3::ZERO);
             match evals {
@@ -108,12 +109,12 @@ impl BlockMatrix {
                 }
             }
         };
-        if parallel {
-            use rayon::prelude::*;
-            parts.par_iter_mut().enumerate().for_each(sum_part);
-        } else {
-            parts.iter_mut().enumerate().for_each(sum_part);
-        }
+        let count = part_count(team, PARTS, 1);
+        for_each_part(team, &mut parts, count, |first, mine| {
+            for (k, out) in mine.iter_mut().enumerate() {
+                sum_part(first + k, out);
+            }
+        });
         for (s, m) in self.blocks.iter_mut().enumerate() {
             *m = parts.iter().fold(Mat3::ZERO, |acc, p| acc + p[s]);
         }

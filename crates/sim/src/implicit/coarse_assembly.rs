@@ -22,17 +22,20 @@ use rustc_hash::FxHashMap as HashMap;
 use std::ops::Range;
 
 use glam::{Mat3, Vec3};
-use rayon::prelude::*;
 
 use super::block_lanes::pair_entries;
 use super::coarse_grid::CoarseGrid;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
+use crate::thread_team::{ThreadTeam, for_each_item, for_each_part, part_count};
 use crate::xpbd::lanes::{LANES, Lane, M3, V3, store_vec};
 
 /// Partial sums of a refresh: a fixed count, so the result does not depend on the
 /// thread count (each part sums its groups in order, the parts are added in order).
 const PARTS: usize = 4;
+
+/// Fewest coarse blocks in a part of the pass that adds the partial sums.
+const SUM_BLOCKS: usize = 512;
 
 /// Most coarse corners one tet's four nodes interpolate from (8 each).
 const MAX_CORNERS: usize = 32;
@@ -206,37 +209,37 @@ impl CoarseAssembly {
 
     /// `out = base + Σ` over the tets with a tangent (`tangent(t)` is `None` for a
     /// released tet) of their Galerkin blocks, row-major per block; eight tets of a group
-    /// at a time in SIMD lanes (AVX2 where the CPU has it).
+    /// at a time in SIMD lanes (AVX2 where the CPU has it), the [`PARTS`] partial sums and
+    /// then the blocks shared by the members of `team` (this thread alone without one).
     pub fn assemble<'a>(
         &mut self,
         base: &[[f64; 9]],
         tangent: impl Fn(usize) -> Option<&'a TetTangent> + Sync,
         out: &mut [[f64; 9]],
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) {
         let mut parts = std::mem::take(&mut self.parts);
         let this = &*self;
-        let part = |(k, sums): (usize, &mut Vec<[f64; 9]>)| {
-            sums.iter_mut().for_each(|s| *s = [0.0; 9]);
-            let mut acc = Vec::new();
-            for g in &this.groups[this.part_groups[k].clone()] {
-                this.add_group(g, &tangent, &mut acc, sums);
+        let count = part_count(team, PARTS, 1);
+        for_each_part(team, &mut parts, count, |first, mine| {
+            for (k, sums) in mine.iter_mut().enumerate() {
+                sums.iter_mut().for_each(|s| *s = [0.0; 9]);
+                let mut acc = Vec::new();
+                for g in &this.groups[this.part_groups[first + k].clone()] {
+                    this.add_group(g, &tangent, &mut acc, sums);
+                }
             }
-        };
-        if parallel {
-            parts.par_iter_mut().enumerate().for_each(part);
-        } else {
-            parts.iter_mut().enumerate().for_each(part);
-        }
-        for (i, o) in out.iter_mut().enumerate().take(self.blocks) {
+        });
+        let sums = &parts;
+        for_each_item(team, &mut out[..self.blocks], SUM_BLOCKS, |i, o| {
             let mut s = base[i];
-            for p in &parts {
+            for p in sums {
                 for (s, v) in s.iter_mut().zip(&p[i]) {
                     *s += v;
                 }
             }
             *o = s;
-        }
+        });
         self.parts = parts;
     }
 
@@ -481,9 +484,15 @@ mod tests {
         let live: Vec<bool> = (0..tets.len()).map(|t| t % 7 != 2).collect();
         let mut out = vec![[0.0; 9]; sys.block_index().len()];
         let zero = vec![[0.0; 9]; out.len()];
-        asm.assemble(&zero, |t| live[t].then(|| &tangents[t]), &mut out, true);
+        let team = ThreadTeam::new(3).unwrap();
+        asm.assemble(
+            &zero,
+            |t| live[t].then(|| &tangents[t]),
+            &mut out,
+            Some(&team),
+        );
         let mut serial = vec![[1.0; 9]; out.len()];
-        asm.assemble(&zero, |t| live[t].then(|| &tangents[t]), &mut serial, false);
+        asm.assemble(&zero, |t| live[t].then(|| &tangents[t]), &mut serial, None);
         assert_eq!(out, serial, "the same sums on any thread count");
         let nc = 3 * grid.count;
         let mut dense = vec![0.0f64; nc * nc];

@@ -18,6 +18,7 @@ use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
 use crate::mesh::TetMesh;
+use crate::thread_team::{ThreadTeam, for_each_item};
 
 /// The coarse grid, its factorised matrix and what a refresh or a release needs.
 pub struct CoarseLevel {
@@ -51,16 +52,20 @@ pub struct CoarseLevel {
 /// How many more coarse nodes than the uncut body's a rebuilt grid may have: one half.
 const SPLIT_GROWTH: usize = 2;
 
+/// Fewest tets in a part of the refresh's pass over the tangents.
+const DEFINITE_TETS: usize = 1024;
+
 impl CoarseLevel {
     /// The coarse level of `mesh` (its `tets` with shape gradients `b`) for the nodes
     /// marked `free`, step length `h`: cubes of `coarse_cell` (default four mean rest
-    /// edges), `A_c = Pᵀ(M/h² + K_rest)P` factorised.
+    /// edges), `A_c = Pᵀ(M/h² + K_rest)P` factorised (assembled on `team`'s threads).
     pub fn new(
         mesh: &TetMesh,
         (tets, b): (&[RestTet], &[[Vec3; 4]]),
         (mass, free): (&[f32], &[bool]),
         (lame, h): (Lame, f32),
         params: &NewtonParams,
+        team: Option<&ThreadTeam>,
     ) -> Result<Self, CoarseError> {
         let cell = params
             .coarse_cell
@@ -70,7 +75,7 @@ impl CoarseLevel {
         let inv_h2 = 1.0 / (h * h);
         let rest = TetTangent::at_rest(lame).definite();
         let (system, assembly) =
-            CoarseSystem::at_rest(&grid, (tets, b), (mass, inv_h2), &rest, true)?;
+            CoarseSystem::at_rest(&grid, (tets, b), (mass, inv_h2), &rest, team)?;
         Ok(CoarseLevel {
             system,
             assembly,
@@ -128,34 +133,30 @@ impl CoarseLevel {
     }
 
     /// Re-assemble the matrix from the positive semi-definite part
-    /// ([`TetTangent::definite`]) of `tangent(t)` (mesh order; on the pool's threads when
-    /// `parallel`) of the tets marked `live` and refactorise; on an error (not positive
-    /// definite) the previous factor stays, while the blocks are these tangents'. First the
-    /// rebuild started at the last refresh is taken, and where tets were released since,
-    /// the next one starts ([`super::coarse_rebuild`]).
+    /// ([`TetTangent::definite`]) of `tangent(t)` (mesh order) of the tets marked `live`
+    /// and refactorise, the tangents and the sums shared by the members of `team`; on an
+    /// error (not positive definite) the previous factor stays, while the blocks are these
+    /// tangents'. First the rebuild started at the last refresh is taken, and where tets
+    /// were released since, the next one starts ([`super::coarse_rebuild`]).
     pub fn refresh(
         &mut self,
         tangent: impl Fn(usize) -> TetTangent + Sync,
         live: &[bool],
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) -> Result<(), CoarseError> {
         let rebuilt = self.take_rebuild();
         self.start_rebuild(live);
-        self.used.clear();
-        let definite = |t: usize| tangent(t).definite();
-        if parallel {
-            use rayon::prelude::*;
-            self.used
-                .par_extend((0..live.len()).into_par_iter().map(definite));
-        } else {
-            self.used.extend((0..live.len()).map(definite));
-        }
+        // One tangent per tet since `new`, each overwritten here.
+        debug_assert_eq!(self.used.len(), live.len());
+        for_each_item(team, &mut self.used, DEFINITE_TETS, |t, out| {
+            *out = tangent(t).definite();
+        });
         self.in_coarse.clear();
         self.in_coarse.extend_from_slice(live);
         self.since_refresh = 0;
         let used = &self.used;
         let tangent = |t: usize| live[t].then(|| &used[t]);
-        let refreshed = self.system.refresh(&mut self.assembly, tangent, parallel);
+        let refreshed = self.system.refresh(&mut self.assembly, tangent, team);
         rebuilt.and(refreshed)
     }
 

@@ -21,6 +21,7 @@ use super::coarse_assembly::{CoarseAssembly, Grouping};
 use super::coarse_grid::CoarseGrid;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
+use crate::thread_team::ThreadTeam;
 
 /// Why the coarse factorisation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -66,10 +67,10 @@ impl CoarseSystem {
         tets: (&[RestTet], &[[Vec3; 4]]),
         mass: (&[f32], f32),
         rest: &TetTangent,
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) -> Result<(Self, CoarseAssembly), CoarseError> {
         let (mut system, mut assembly) = Self::with_assembly(grid, tets, mass)?;
-        system.refresh(&mut assembly, |_| Some(rest), parallel)?;
+        system.refresh(&mut assembly, |_| Some(rest), team)?;
         Ok((system, assembly))
     }
 
@@ -150,9 +151,9 @@ impl CoarseSystem {
         &mut self,
         assembly: &mut CoarseAssembly,
         tangent: impl Fn(usize) -> Option<&'a TetTangent> + Sync,
-        parallel: bool,
+        team: Option<&ThreadTeam>,
     ) -> Result<(), CoarseError> {
-        assembly.assemble(&self.mass_blocks, tangent, &mut self.blocks, parallel);
+        assembly.assemble(&self.mass_blocks, tangent, &mut self.blocks, team);
         self.refactor()
     }
 
@@ -342,7 +343,7 @@ mod tests {
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
         let rest = TetTangent::at_rest(lame());
         let (sys, _) =
-            CoarseSystem::at_rest(&grid, (&tets, &b), (&mass, 3600.0), &rest, true).unwrap();
+            CoarseSystem::at_rest(&grid, (&tets, &b), (&mass, 3600.0), &rest, None).unwrap();
         let nc = 3 * grid.count;
         // Dense Pᵀ A P.
         let mut dense = vec![0.0f64; nc * nc];

@@ -86,7 +86,7 @@ pub struct NewtonWorkspace {
 impl NewtonWorkspace {
     /// The workspace for `mesh` with lumped `mass`, the nodes marked `free` solved for,
     /// step length `h`, the Hessian product in SIMD lanes or (`lanes` false) tet by tet:
-    /// builds the coarse grid and factorises its matrix.
+    /// builds the coarse grid and factorises its matrix (assembled on `team`'s threads).
     pub fn new(
         mesh: &TetMesh,
         mass: &[f32],
@@ -94,13 +94,14 @@ impl NewtonWorkspace {
         lame: Lame,
         (h, lanes): (f32, bool),
         params: NewtonParams,
+        team: Option<&ThreadTeam>,
     ) -> Result<Self, CoarseError> {
         let tets = RestTet::all(mesh);
         let inv_h2 = 1.0 / (h * h);
         let (inc_offsets, inc) = (mesh.node_tet_offsets.clone(), mesh.node_corners());
         let n = mesh.node_count();
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
-        let level = CoarseLevel::new(mesh, (&tets, &b), (mass, free), (lame, h), &params)?;
+        let level = CoarseLevel::new(mesh, (&tets, &b), (mass, free), (lame, h), &params, team)?;
         let evals = TetEvals::at_rest(&tets, &b, lame, lanes);
         let matrix = (params.smoother == Smoother::GaussSeidel).then(|| BlockMatrix::new(n, &tets));
         Ok(NewtonWorkspace {
@@ -172,19 +173,13 @@ impl NewtonWorkspace {
         self.hessian.find_active(live, free);
         if self.pre.level.refresh_due(&self.last) {
             report.coarse_refreshed = true;
-            report.coarse_refresh_failed = self.refresh_coarse(live, team.is_some()).is_err();
+            report.coarse_refresh_failed = self.refresh_coarse(live, team).is_err();
         }
         self.pre.level.tick();
         if let Some(m) = &mut self.pre.matrix {
             let h = &self.hessian;
             let mass = |i: usize| h.mass[i] * h.inv_h2;
-            m.assemble(
-                (&h.tets, &h.b),
-                (&h.evals, live),
-                mass,
-                true,
-                team.is_some(),
-            );
+            m.assemble((&h.tets, &h.b), (&h.evals, live), mass, true, team);
         }
         let mut first_norm = None;
         for _ in 0..self.params.iterations {
@@ -263,9 +258,13 @@ impl NewtonWorkspace {
 
     /// Re-assemble the coarse matrix from the live tets' current tangents and refactorise
     /// it (the previous factor stays where the new one fails).
-    fn refresh_coarse(&mut self, live: &[bool], parallel: bool) -> Result<(), CoarseError> {
+    fn refresh_coarse(
+        &mut self,
+        live: &[bool],
+        team: Option<&ThreadTeam>,
+    ) -> Result<(), CoarseError> {
         let evals = &self.hessian.evals;
-        let done = self.pre.level.refresh(|t| evals.tangent(t), live, parallel);
+        let done = self.pre.level.refresh(|t| evals.tangent(t), live, team);
         self.pre.rhs.resize(3 * self.pre.level.grid.count, 0.0);
         done
     }
@@ -550,6 +549,7 @@ mod tests {
             lame,
             (1.0 / 60.0, lanes),
             NewtonParams::default(),
+            None,
         )
         .unwrap();
         (mesh, ws, free)
@@ -579,6 +579,7 @@ mod tests {
                 lame,
                 (1.0 / 60.0, lanes),
                 NewtonParams::default(),
+                None,
             )
             .unwrap()
         };
@@ -728,7 +729,7 @@ mod tests {
                 let h = &ws.hessian;
                 let mut m = BlockMatrix::new(n, &h.tets);
                 let mass = |i: usize| h.mass[i] * h.inv_h2;
-                m.assemble((&h.tets, &h.b), (&h.evals, &live), mass, !exact, true);
+                m.assemble((&h.tets, &h.b), (&h.evals, &live), mass, !exact, None);
                 let mut got = vec![Vec3::ZERO; n];
                 m.mul(&p, &mut got, &free);
                 (want, got)
@@ -854,7 +855,7 @@ mod tests {
         let mut solved = Vec::new();
         for ws in [&mut fresh, &mut released] {
             ws.hessian.evaluate(&u, &u, &live, &free, None);
-            ws.refresh_coarse(&live, false).unwrap();
+            ws.refresh_coarse(&live, None).unwrap();
         }
         released.release(&[5]).unwrap();
         for ws in [&fresh, &released] {
@@ -884,7 +885,7 @@ mod tests {
         live[5] = false;
         live[40] = false;
         refreshed.hessian.evaluate(&rest, &rest, &live, &free, None);
-        refreshed.refresh_coarse(&live, false).unwrap();
+        refreshed.refresh_coarse(&live, None).unwrap();
         released.release(&[5, 40]).unwrap();
         let rhs: Vec<f64> = (0..released.pre.rhs.len())
             .map(|i| (i as f64 * 0.37).sin())

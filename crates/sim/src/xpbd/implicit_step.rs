@@ -79,7 +79,16 @@ impl Solver {
         let free: Vec<bool> = self.kind.iter().map(|k| *k == NodeKind::Free).collect();
         // The SIMD product unless the scalar reference kernel is asked for.
         let lanes = self.params.cpu_kernel != CpuKernel::Scalar;
-        let ws = NewtonWorkspace::new(&self.mesh, &self.mass, &free, self.lame, (h, lanes), p)?;
+        let team = self.team.as_ref();
+        let ws = NewtonWorkspace::new(
+            &self.mesh,
+            &self.mass,
+            &free,
+            self.lame,
+            (h, lanes),
+            p,
+            team,
+        )?;
         self.newton = Some(ws);
         Ok(())
     }

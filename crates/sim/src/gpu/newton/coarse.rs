@@ -10,6 +10,7 @@ use glam::Vec3;
 use crate::implicit::{CoarseError, CoarseLevel, NewtonParams, NewtonReport, RestTet, TetTangent};
 use crate::material::Lame;
 use crate::mesh::TetMesh;
+use crate::thread_team::ThreadTeam;
 use crate::vbd::shape_gradients;
 
 /// Most coarse nodes the device takes: its `A_c⁻¹` is dense (9 n² values, 38 MB at this
@@ -21,6 +22,9 @@ pub(crate) struct HostCoarse {
     level: CoarseLevel,
     tets: Vec<RestTet>,
     lame: Lame,
+    /// The host's threads for a refresh (one per core; `None` where none could be
+    /// started: the sums then run on this thread, to the same result).
+    team: Option<ThreadTeam>,
 }
 
 impl HostCoarse {
@@ -35,8 +39,22 @@ impl HostCoarse {
     ) -> Result<Self, CoarseError> {
         let tets = RestTet::all(mesh);
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
-        let level = CoarseLevel::new(mesh, (&tets, &b), (mass, free), (lame, h), params)?;
-        Ok(HostCoarse { level, tets, lame })
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let team = ThreadTeam::new(cores).ok();
+        let level = CoarseLevel::new(
+            mesh,
+            (&tets, &b),
+            (mass, free),
+            (lame, h),
+            params,
+            team.as_ref(),
+        )?;
+        Ok(HostCoarse {
+            level,
+            tets,
+            lame,
+            team,
+        })
     }
 
     /// Coarse nodes.
@@ -101,12 +119,12 @@ impl HostCoarse {
     /// Re-assemble the coarse matrix from the tangents at the displacements `u` of the
     /// tets marked `live` (mesh order) and refactorise; on an error (not positive
     /// definite) the previous factor stays. The tangents are those of the step's first
-    /// iterate, as on the CPU; computed on the host's pool (the sums run in fixed parts,
+    /// iterate, as on the CPU; computed on the host's team (the sums run in fixed parts,
     /// so the result does not depend on its size).
     pub fn refresh(&mut self, u: &[Vec3], live: &[bool]) -> Result<(), CoarseError> {
         let (lame, tets) = (self.lame, &self.tets);
         let tangent = |t: usize| TetTangent::at(&tets[t].strain(u), lame);
-        self.level.refresh(tangent, live, true)
+        self.level.refresh(tangent, live, self.team.as_ref())
     }
 
     /// One more step since the last refresh.
