@@ -106,13 +106,33 @@ pub struct Solver {
     pub(crate) implicit_cost: crate::implicit::FrameCost,
     /// Coarse nodes after the last implicit step (0 under XPBD).
     pub(crate) coarse_nodes: u32,
-    pub(crate) pool: Option<rayon::ThreadPool>,
-    /// The pool's threads as a team for the sweeps' passes (`thread_team.rs`): its
-    /// members wait for the next pass spinning, not asleep.
+    /// The threads of the solver's passes (`thread_team.rs`; `None`: one thread): the
+    /// caller and a member per further core, waiting for the next pass spinning, not
+    /// asleep.
     pub(crate) team: Option<ThreadTeam>,
     /// The implicit scheme's buffers and preconditioner, built at its first step (when
     /// the pins and grabs are known).
     pub(crate) newton: Option<NewtonWorkspace>,
+}
+
+/// The team for `threads` solver threads (0: one per core; 1: none, every pass on the
+/// caller's thread), at most one member per core: a member that waits spinning for a core
+/// another member holds would stall every pass.
+fn solver_team(threads: usize) -> Result<Option<ThreadTeam>, SolverError> {
+    if threads == 1 {
+        return Ok(None);
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let size = if threads == 0 {
+        cores
+    } else {
+        threads.min(cores)
+    };
+    let team = ThreadTeam::new(size).map_err(|e| SolverError::ThreadPool {
+        threads: size,
+        msg: e.to_string(),
+    })?;
+    Ok(Some(team))
 }
 
 impl Solver {
@@ -172,30 +192,7 @@ impl Solver {
                 });
             }
         }
-        let pool = match params.threads {
-            1 => None,
-            n => Some(
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
-                    .build()
-                    .map_err(|e| SolverError::ThreadPool {
-                        threads: n,
-                        msg: e.to_string(),
-                    })?,
-            ),
-        };
-        let team = match &pool {
-            Some(p) => {
-                let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-                let size = p.current_num_threads().min(cores);
-                let team = ThreadTeam::new(size).map_err(|e| SolverError::ThreadPool {
-                    threads: size,
-                    msg: e.to_string(),
-                })?;
-                Some(team)
-            }
-            None => None,
-        };
+        let team = solver_team(params.threads)?;
         let n = mesh.node_count();
         let t = mesh.tet_count();
         let mut solver = Solver {
@@ -233,7 +230,6 @@ impl Solver {
             passes: 0,
             implicit_cost: Default::default(),
             coarse_nodes: 0,
-            pool,
             team,
             newton: None,
             lame,
@@ -524,17 +520,18 @@ impl Solver {
         let t0 = Instant::now();
         self.near_edge.iter_mut().for_each(|b| *b = false);
         self.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
+        let parallel = self.team.is_some();
         let fresh = match self.params.scheme {
-            Scheme::Xpbd => self.with_pool(|s, parallel| s.run_substeps(parallel)),
+            Scheme::Xpbd => self.run_substeps(parallel),
             Scheme::Newton(p) => {
                 let start = (&saved.0[..], &saved.1[..], &saved.2[..]);
-                self.with_pool(|s, parallel| s.run_implicit_steps(p, start, parallel))?
+                self.run_implicit_steps(p, start, parallel)?
             }
         };
         self.time += self.params.frame_dt as f64;
         self.sync_positions();
         let t1 = Instant::now();
-        let checked = self.with_pool(|s, parallel| s.update_stress_and_check(parallel, fresh));
+        let checked = self.update_stress_and_check(parallel, fresh);
         if let Err(e) = checked {
             self.u = saved.0;
             self.u_prev.clone_from(&self.u);
@@ -560,21 +557,6 @@ impl Solver {
         stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
         self.frame += 1;
         Ok(stats)
-    }
-
-    /// Run `f` inside the solver's thread pool (parallel) or on this thread.
-    fn with_pool<R>(&mut self, f: impl FnOnce(&mut Self, bool) -> R + Send) -> R
-    where
-        R: Send,
-    {
-        match self.pool.take() {
-            Some(pool) => {
-                let r = pool.install(|| f(self, true));
-                self.pool = Some(pool);
-                r
-            }
-            None => f(self, false),
-        }
     }
 
     /// Switch the tets of a rolled-back frame's release checks back on.
