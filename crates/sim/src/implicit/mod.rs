@@ -17,6 +17,7 @@ mod newton_report;
 mod params;
 mod pcg;
 mod product_lanes;
+mod product_parts;
 mod rest_tet;
 mod tet_evals;
 mod tet_tangent;

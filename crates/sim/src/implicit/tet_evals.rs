@@ -6,6 +6,7 @@ use glam::{Mat3, Vec3, Vec3A};
 
 use super::eval_lanes::{self, EvalLanes};
 use super::product_lanes::{RestLanes, TangentLanes, product_add, rest_lanes, tangent_lanes};
+use super::product_parts::ProductParts;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
@@ -136,29 +137,24 @@ impl TetEvals {
     }
 }
 
-/// Fixed ranges of the tets whose product forces are summed apart (each a part of the
-/// team's pass) and then added in order, so the sums do not depend on the
-/// thread count.
-pub(super) const PRODUCT_PARTS: usize = 4;
-
 impl TetEvals {
     /// The live tets' nodal forces `V dP[dF(p)] b_a` for the direction `p = at.u` at the
-    /// last evaluation's tangents, summed per node into `parts` ([`PRODUCT_PARTS`] node
-    /// vectors, one per fixed range of tets): the tets' part of the Hessian product.
-    /// Only the chunks of eight tets listed in `active` are summed (those with a free
-    /// node: the others' forces fall on fixed nodes alone), split into the parts in order.
+    /// last evaluation's tangents, summed per node into `parts` (one node vector per fixed
+    /// range of tets, [`ProductParts`]): the tets' part of the Hessian product. Only the
+    /// chunks of eight tets listed in `active` are summed (those with a free node: the
+    /// others' forces fall on fixed nodes alone), split into the parts in order, as
+    /// [`ProductParts::set_chunks`] was given them.
     pub(super) fn products(
         &self,
         tets: &[RestTet],
         at: Iterate,
         active: &[u32],
-        parts: &mut [Vec<Vec3A>],
+        parts: &mut ProductParts,
     ) {
-        let per = active.len().div_ceil(PRODUCT_PARTS).max(1);
+        let (parts, ranges) = parts.split();
         let run = |(k, sums): (usize, &mut Vec<Vec3A>)| {
-            sums.clear();
-            sums.resize(at.u.len(), Vec3A::ZERO);
-            let mine = &active[(k * per).min(active.len())..((k + 1) * per).min(active.len())];
+            sums[ranges[k].clone()].fill(Vec3A::ZERO);
+            let mine = ProductParts::chunks(active, k);
             match self {
                 TetEvals::Lanes { rest, tangents, .. } => {
                     for &c in mine {

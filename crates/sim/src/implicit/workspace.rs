@@ -21,8 +21,9 @@ use super::coarse_system::CoarseError;
 use super::newton_report::NewtonReport;
 use super::params::{NewtonParams, Smoother};
 use super::pcg::{dot, pcg};
+use super::product_parts::ProductParts;
 use super::rest_tet::RestTet;
-use super::tet_evals::{Iterate, PRODUCT_PARTS, TetEvals, active_chunks, for_each};
+use super::tet_evals::{Iterate, TetEvals, active_chunks, for_each};
 use crate::material::Lame;
 use crate::mesh::TetMesh;
 use crate::thread_team::{ThreadTeam, for_each_zip2};
@@ -49,7 +50,7 @@ struct Hessian {
     /// (the reference).
     evals: TetEvals,
     /// The tets' product forces summed per node, one vector per fixed range of tets.
-    product_parts: Vec<Vec<Vec3A>>,
+    product_parts: ProductParts,
     /// The chunks of eight tets whose forces reach a free node (found once a step).
     active: Vec<u32>,
     /// Per chunk, whether none of its tets reaches a free node (empty: none known).
@@ -110,7 +111,7 @@ impl NewtonWorkspace {
             hessian: Hessian {
                 b,
                 evals,
-                product_parts: vec![Vec::new(); PRODUCT_PARTS],
+                product_parts: ProductParts::default(),
                 active: Vec::new(),
                 fixed: Vec::new(),
                 tets,
@@ -419,6 +420,9 @@ impl Hessian {
     /// sums): once a step, as `live` and `free` change only between steps.
     fn find_active(&mut self, live: &[bool], free: &[bool]) {
         self.active = active_chunks(&self.tets, live, free);
+        let nodes = self.mass.len();
+        self.product_parts
+            .set_chunks(&self.tets, &self.active, nodes);
         self.fixed.clear();
         self.fixed.resize(self.tets.len().div_ceil(LANES), true);
         for &c in &self.active {
@@ -463,11 +467,8 @@ impl Hessian {
                 *o = Vec3::ZERO;
                 return;
             }
-            let mut sum = p[i] * (mass[i] * inv_h2);
-            for part in parts {
-                sum += Vec3::from(part[i]);
-            }
-            *o = sum;
+            let inertia = Vec3A::from(p[i] * (mass[i] * inv_h2));
+            *o = parts.add_at(i, inertia).into();
         };
         for_each(team, out, node);
     }
