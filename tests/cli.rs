@@ -33,13 +33,16 @@ fn run_writes_report_snapshots_and_collection() {
         "--vtu-every",
         "10",
         "--threads",
-        "2",
+        "4",
     ]);
     assert!(o.status.success(), "stderr: {}", text(&o.stderr));
     assert!(text(&o.stdout).contains("report:"));
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["status"], "completed");
+    // The threads the solver runs on: at most one per core, whatever was asked.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    assert_eq!(report["threads"], 4.min(cores) as u64);
     let frames = report["frames"].as_array().unwrap();
     assert_eq!(frames.len(), 30, "0.5 s at 60 Hz");
     for key in [

@@ -149,10 +149,7 @@ pub fn open(
     }
     report.device = body.device();
     report.device_choice = choice;
-    report.threads = match body.solver().params().threads {
-        0 => rayon::current_num_threads(),
-        n => n,
-    };
+    report.threads = body.solver().threads();
     Ok((
         XpbdBody {
             body,

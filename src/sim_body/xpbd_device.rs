@@ -14,7 +14,7 @@ pub enum DeviceChoice {
     /// The GPU when an adapter exists, else the CPU with a one-line notice.
     #[default]
     Auto,
-    /// The CPU reference solver (rayon).
+    /// The CPU reference solver (on a thread per core).
     Cpu,
     /// The wgpu compute solver; an error when no adapter exists.
     Gpu,

@@ -611,6 +611,12 @@ impl Solver {
         self.check_ms += t0.elapsed().as_secs_f64() * 1e3;
     }
 
+    /// The threads the solver's passes run on: its team's members (the caller among
+    /// them), 1 without a team.
+    pub fn threads(&self) -> usize {
+        self.team.as_ref().map_or(1, ThreadTeam::size)
+    }
+
     /// The implicit scheme's last step: Newton iterations and conjugate-gradient products
     /// (`None` under XPBD or before the first frame).
     pub fn newton_report(&self) -> Option<NewtonReport> {
