@@ -69,7 +69,7 @@ pub enum Command {
         /// Frames to compare (default: the scene's duration).
         #[arg(long)]
         frames: Option<u64>,
-        /// CPU solver threads (0: all cores).
+        /// CPU solver threads (0: all cores; at most one per core).
         #[arg(long)]
         threads: Option<usize>,
         /// Print JSON instead of text.
@@ -388,7 +388,7 @@ pub struct RunArgs {
     /// Write a .vtu snapshot every K frames (0: none).
     #[arg(long, default_value_t = 10)]
     pub vtu_every: u64,
-    /// Solver threads (0: all cores; default: the scene's setting).
+    /// Solver threads (0: all cores, at most one per core; default: the scene's setting).
     #[arg(long)]
     pub threads: Option<usize>,
     /// No progress output.
