@@ -402,17 +402,14 @@ impl Hessian {
         diag_inv: &mut [Mat3],
         team: Option<&ThreadTeam>,
     ) {
-        let node = |i: usize, out: (&mut Vec3, &mut Mat3)| {
-            if !free[i] {
-                *out.0 = Vec3::ZERO;
-                *out.1 = Mat3::ZERO;
-                return;
-            }
-            let (g, d) = self.node_sums(u, y, i);
-            *out.0 = g;
-            *out.1 = d.inverse();
+        let node = |i: usize, g: &mut Vec3, d_inv: &mut Mat3| {
+            (*g, *d_inv) = if free[i] {
+                let (g, d) = self.node_sums(u, y, i);
+                (g, d.inverse())
+            } else {
+                (Vec3::ZERO, Mat3::ZERO)
+            };
         };
-        let node = |i: usize, g: &mut Vec3, d: &mut Mat3| node(i, (g, d));
         for_each_zip2(team, (gradient, diag_inv), CHUNK, node);
     }
 

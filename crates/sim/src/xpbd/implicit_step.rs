@@ -102,7 +102,6 @@ impl Solver {
         &mut self,
         p: NewtonParams,
         saved: Saved,
-        parallel: bool,
     ) -> Result<bool, SolverError> {
         self.prepare_implicit(p)?;
         self.implicit_cost = Default::default();
@@ -111,7 +110,7 @@ impl Solver {
         let start = self.tool.is_some().then(|| FrameStart::of(self, saved));
         let mut n = p.steps;
         loop {
-            let fresh = self.implicit_steps(n, parallel);
+            let fresh = self.implicit_steps(n);
             let Some(start) = &start else {
                 return Ok(fresh);
             };
@@ -125,7 +124,7 @@ impl Solver {
     }
 
     /// `n` implicit steps over the frame with the release checks that fall in them.
-    fn implicit_steps(&mut self, n: u32, parallel: bool) -> bool {
+    fn implicit_steps(&mut self, n: u32) -> bool {
         let h = self.params.frame_dt / n as f32;
         if let Some(ws) = &mut self.newton {
             ws.set_step_length(h);
@@ -136,11 +135,11 @@ impl Solver {
         let mut fresh = false;
         self.passes += checks.len() as u32;
         for s in 0..n {
-            let held = self.implicit_step((s, n), &free, parallel);
+            let held = self.implicit_step((s, n), &free);
             fresh = next.next_if(|&&k| k == s).is_some();
             if fresh {
                 let before = self.pending.len();
-                self.release_check(parallel);
+                self.release_check();
                 self.unload_released(h, &held, before);
             }
         }
@@ -167,7 +166,7 @@ impl Solver {
     /// One implicit Euler step, `s` of `n` in the frame: prediction, the nodes in the
     /// tool's path held, the solve (again with the nodes it carried into the tool), the
     /// held nodes' reactions, contact and velocities; returns the nodes it held.
-    fn implicit_step(&mut self, (s, n): (u32, u32), free: &[bool], parallel: bool) -> Vec<bool> {
+    fn implicit_step(&mut self, (s, n): (u32, u32), free: &[bool]) -> Vec<bool> {
         let h = self.params.frame_dt / n as f32;
         let t = self.time + (s + 1) as f64 * h as f64;
         self.predict(h, t);
@@ -189,7 +188,7 @@ impl Solver {
         let live = self.live_tets();
         for pass in 0..=CONTACT_RESOLVES {
             let step_free: Vec<bool> = free.iter().zip(&held).map(|(f, h)| *f && !*h).collect();
-            self.implicit_solve(&y, &live, &step_free, parallel);
+            self.implicit_solve(&y, &live, &step_free);
             if pass == CONTACT_RESOLVES {
                 break;
             }
@@ -234,15 +233,9 @@ impl Solver {
 
     /// One Newton solve of the step from `u` to the minimum of `G` (target `y`), the nodes
     /// not `free` held; its cost booked.
-    fn implicit_solve(&mut self, y: &[Vec3], live: &[bool], free: &[bool], parallel: bool) {
+    fn implicit_solve(&mut self, y: &[Vec3], live: &[bool], free: &[bool]) {
         if let Some(ws) = &mut self.newton {
-            ws.solve(
-                &mut self.u,
-                y,
-                live,
-                free,
-                self.team.as_ref().filter(|_| parallel),
-            );
+            ws.solve(&mut self.u, y, live, free, self.team.as_ref());
             let r = ws.last;
             self.implicit_cost.add(&r);
             self.coarse_nodes = r.coarse_nodes;

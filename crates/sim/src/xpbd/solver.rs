@@ -520,18 +520,17 @@ impl Solver {
         let t0 = Instant::now();
         self.near_edge.iter_mut().for_each(|b| *b = false);
         self.contact_push.iter_mut().for_each(|p| *p = Vec3::ZERO);
-        let parallel = self.team.is_some();
         let fresh = match self.params.scheme {
-            Scheme::Xpbd => self.run_substeps(parallel),
+            Scheme::Xpbd => self.run_substeps(),
             Scheme::Newton(p) => {
                 let start = (&saved.0[..], &saved.1[..], &saved.2[..]);
-                self.run_implicit_steps(p, start, parallel)?
+                self.run_implicit_steps(p, start)?
             }
         };
         self.time += self.params.frame_dt as f64;
         self.sync_positions();
         let t1 = Instant::now();
-        let checked = self.update_stress_and_check(parallel, fresh);
+        let checked = self.update_stress_and_check(fresh);
         if let Err(e) = checked {
             self.u = saved.0;
             self.u_prev.clone_from(&self.u);
@@ -570,7 +569,7 @@ impl Solver {
     /// and release (PHYSICS.md §1.4 on a fixed simulation-time interval). Returns whether
     /// the stress is current for the end of the frame (a check ran after the last
     /// substep).
-    fn run_substeps(&mut self, parallel: bool) -> bool {
+    fn run_substeps(&mut self) -> bool {
         let h = self.params.substep();
         let n = self.params.substeps;
         let checks = release_checks(self.time, h, n, self.params.release_interval);
@@ -588,25 +587,25 @@ impl Solver {
             match self.params.cpu_sweep {
                 CpuSweep::Coloured => {
                     for c in 0..self.color_ranges.len() {
-                        self.project_color(c, parallel);
+                        self.project_color(c);
                     }
                 }
-                CpuSweep::Blocks => self.project_blocks(parallel),
+                CpuSweep::Blocks => self.project_blocks(),
             }
             self.project_contacts(s, n);
             self.update_velocities(h);
             fresh = next.next_if(|&&k| k == s).is_some();
             if fresh {
-                self.release_check(parallel);
+                self.release_check();
             }
         }
         fresh
     }
 
     /// Stress, then the tets over the threshold switched off (PHYSICS.md §1.4), timed.
-    pub(crate) fn release_check(&mut self, parallel: bool) {
+    pub(crate) fn release_check(&mut self) {
         let t0 = Instant::now();
-        self.compute_stress(parallel);
+        self.compute_stress();
         self.switch_off_overstressed();
         self.check_ms += t0.elapsed().as_secs_f64() * 1e3;
     }
@@ -706,17 +705,17 @@ impl Solver {
     }
 
     /// Project every live tet of colour `c` (no two share a node), in parts shared by the
-    /// team when `parallel`.
-    fn project_color(&mut self, c: usize, parallel: bool) {
+    /// team where there is one.
+    fn project_color(&mut self, c: usize) {
         let range = self.color_ranges[c].clone();
         let packed = self.packed.as_ref();
         let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
         let nodes = SharedNodes::new(&mut self.u);
         let lambdas = SharedLambdas::new(&mut self.lambda_h);
         // A colour of few tets costs less on one thread than split.
-        let parts = match parallel && self.team.is_some() {
-            true => (range.len() / TEAM_PART_TETS).max(1),
-            false => 1,
+        let parts = match self.team {
+            Some(_) => (range.len() / TEAM_PART_TETS).max(1),
+            None => 1,
         };
         // SAFETY: tets of one colour share no node, and the parts are disjoint; this pass
         // is the only one. The packed spans of the coloured sweep are its colours.
@@ -730,7 +729,7 @@ impl Solver {
 
     /// One sweep in the partitioned order (`xpbd/sweep_plan.rs`): phase after phase, the
     /// phase's groups shared by the team, each group's tets colour after colour.
-    fn project_blocks(&mut self, parallel: bool) {
+    fn project_blocks(&mut self) {
         let packed = self.packed.as_ref();
         let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
         let nodes = SharedNodes::new(&mut self.u);
@@ -746,7 +745,7 @@ impl Solver {
             }
         };
         for phase in &plan.phases {
-            match self.team.as_ref().filter(|_| parallel) {
+            match self.team.as_ref() {
                 Some(team) => team.run(phase.len(), |p| group(&phase[p])),
                 None => phase.iter().for_each(group),
             }
@@ -771,11 +770,11 @@ impl Solver {
 
     /// Stress and det F per live tet (unless `fresh` from a check after the last
     /// substep), then the NaN and inversion guards.
-    fn update_stress_and_check(&mut self, parallel: bool, fresh: bool) -> Result<(), SolverError> {
+    fn update_stress_and_check(&mut self, fresh: bool) -> Result<(), SolverError> {
         self.check_finite()?;
         if !fresh {
             self.passes += 1;
-            self.compute_stress(parallel);
+            self.compute_stress();
         }
         self.check_inversion()
     }
@@ -806,7 +805,7 @@ impl Solver {
     }
 
     /// σ_vM and det F of every live tet (and, for the seed's eq. 3, the polar rotation).
-    fn compute_stress(&mut self, parallel: bool) {
+    fn compute_stress(&mut self) {
         let eval = TetStressEval {
             mesh: &self.mesh,
             u: &self.u,
@@ -820,13 +819,12 @@ impl Solver {
             h2: self.params.substep() * self.params.substep(),
         };
         let compute = |t: usize, vm: &mut f32, d: &mut f32, r: &mut Quat| eval.tet(t, (vm, d, r));
-        let team = self.team.as_ref().filter(|_| parallel);
         let arrays = (
             &mut self.von_mises[..],
             &mut self.det_f[..],
             &mut self.rotation[..],
         );
-        for_each_zip3(team, arrays, TEAM_PART_TETS, compute);
+        for_each_zip3(self.team.as_ref(), arrays, TEAM_PART_TETS, compute);
     }
 
     /// Count consecutive inverted frames per live tet; error past the limit.
