@@ -22,39 +22,24 @@ pub(crate) struct HostCoarse {
     level: CoarseLevel,
     tets: Vec<RestTet>,
     lame: Lame,
-    /// The host's threads for a refresh (one per core; `None` where none could be
-    /// started: the sums then run on this thread, to the same result).
-    team: Option<ThreadTeam>,
 }
 
 impl HostCoarse {
     /// The coarse level of `mesh` for the nodes marked `free`, as
-    /// `NewtonWorkspace::new` builds it ([`CoarseLevel::new`]).
+    /// `NewtonWorkspace::new` builds it ([`CoarseLevel::new`]), assembled on the host
+    /// solver's `team`.
     pub fn new(
         mesh: &TetMesh,
         mass: &[f32],
         free: &[bool],
         (lame, h): (Lame, f32),
         params: &NewtonParams,
+        team: Option<&ThreadTeam>,
     ) -> Result<Self, CoarseError> {
         let tets = RestTet::all(mesh);
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let team = ThreadTeam::new(cores).ok();
-        let level = CoarseLevel::new(
-            mesh,
-            (&tets, &b),
-            (mass, free),
-            (lame, h),
-            params,
-            team.as_ref(),
-        )?;
-        Ok(HostCoarse {
-            level,
-            tets,
-            lame,
-            team,
-        })
+        let level = CoarseLevel::new(mesh, (&tets, &b), (mass, free), (lame, h), params, team)?;
+        Ok(HostCoarse { level, tets, lame })
     }
 
     /// Coarse nodes.
@@ -119,12 +104,17 @@ impl HostCoarse {
     /// Re-assemble the coarse matrix from the tangents at the displacements `u` of the
     /// tets marked `live` (mesh order) and refactorise; on an error (not positive
     /// definite) the previous factor stays. The tangents are those of the step's first
-    /// iterate, as on the CPU; computed on the host's team (the sums run in fixed parts,
-    /// so the result does not depend on its size).
-    pub fn refresh(&mut self, u: &[Vec3], live: &[bool]) -> Result<(), CoarseError> {
+    /// iterate, as on the CPU; computed on the host solver's `team` (the sums run in fixed
+    /// parts, so the result does not depend on its size).
+    pub fn refresh(
+        &mut self,
+        u: &[Vec3],
+        live: &[bool],
+        team: Option<&ThreadTeam>,
+    ) -> Result<(), CoarseError> {
         let (lame, tets) = (self.lame, &self.tets);
         let tangent = |t: usize| TetTangent::at(&tets[t].strain(u), lame);
-        self.level.refresh(tangent, live, self.team.as_ref())
+        self.level.refresh(tangent, live, team)
     }
 
     /// One more step since the last refresh.

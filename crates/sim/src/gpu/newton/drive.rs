@@ -13,6 +13,7 @@ use super::layout::{ALPHA_OFFSET, S_FIRST, S_NEG, S_PRODUCTS, S_STOP, V_TRIAL};
 use crate::gpu::GpuError;
 use crate::gpu::readback::read_mapped;
 use crate::implicit::NewtonReport;
+use crate::thread_team::ThreadTeam;
 
 /// Armijo constant of the line search (the CPU's).
 const ARMIJO: f64 = 1e-4;
@@ -98,12 +99,12 @@ impl GpuNewton {
     /// Minimise `G` from the iterate in `pos`: right after [`GpuNewton::start_step`]
     /// (which set the point to evaluate), or, `again`, as a further solve of the step
     /// left it and the contact moved it since; `enc` holds the commands recorded so far.
-    /// `live` per tet (mesh order) is what a coarse refresh assembles. Returns an encoder
-    /// to record the rest of the frame in.
+    /// `live` per tet (mesh order) is what a coarse refresh assembles, on the host
+    /// solver's `team`. Returns an encoder to record the rest of the frame in.
     pub fn solve_step(
         &mut self,
         dev: &OnDevice<'_>,
-        live: &[bool],
+        (live, team): (&[bool], Option<&ThreadTeam>),
         mut enc: wgpu::CommandEncoder,
         again: bool,
     ) -> Result<wgpu::CommandEncoder, GpuError> {
@@ -124,7 +125,7 @@ impl GpuNewton {
         let mut now = self.sums(&scratch);
         if let Some(u) = first_iterate {
             report.coarse_refreshed = true;
-            report.coarse_refresh_failed = self.coarse.refresh(&u, live).is_err();
+            report.coarse_refresh_failed = self.coarse.refresh(&u, live, team).is_err();
             self.upload_coarse(dev.queue);
         }
         self.coarse.tick();

@@ -153,7 +153,8 @@ impl GpuNewton {
         let (n, slots) = (host.x.len(), host.slots.len());
         let h = host.params.step_length();
         let free: Vec<bool> = host.kind.iter().map(|k| *k == NodeKind::Free).collect();
-        let mut coarse = HostCoarse::new(mesh, &host.mass, &free, (host.lame, h), &params)?;
+        let team = host.team.as_ref();
+        let mut coarse = HostCoarse::new(mesh, &host.mass, &free, (host.lame, h), &params, team)?;
         if coarse.nodes() > coarse::MAX_COARSE_NODES {
             return Err(GpuError::CoarseTooLarge {
                 nodes: coarse.nodes(),

@@ -79,7 +79,8 @@ impl GpuSolver {
                 pos: &self.buf.pos,
                 read_pos: &self.read.pos,
             };
-            enc = newton.solve_step(&dev, &live, enc, false)?;
+            let host = (&live[..], self.host.team.as_ref());
+            enc = newton.solve_step(&dev, host, enc, false)?;
             let mut r = newton.last;
             if self.host.tool.is_some() {
                 dispatches += 1;
@@ -87,7 +88,8 @@ impl GpuSolver {
                 // (CPU twin: the resolve pass of Solver::run_implicit_steps).
                 if self.record_resolve(enc, s)? > 0 {
                     self.host.implicit_cost.add(&r);
-                    enc = newton.solve_step(&dev, &live, new_encoder(&self.device), true)?;
+                    let host = (&live[..], self.host.team.as_ref());
+                    enc = newton.solve_step(&dev, host, new_encoder(&self.device), true)?;
                     r = newton.last;
                 } else {
                     enc = new_encoder(&self.device);
