@@ -10,7 +10,7 @@ use super::coarse_assembly::pair_block;
 use super::product_lanes::{RestLanes, TangentLanes};
 use super::rest_tet::RestTet;
 use super::tet_evals::TetEvals;
-use crate::thread_team::{ThreadTeam, for_each_part, part_count};
+use crate::thread_team::{ThreadTeam, for_each_item};
 use crate::xpbd::lanes::LANES;
 
 /// A block-sparse symmetric matrix on the mesh's node graph, rows by node, columns
@@ -109,12 +109,7 @@ impl BlockMatrix {
                 }
             }
         };
-        let count = part_count(team, PARTS, 1);
-        for_each_part(team, &mut parts, count, |first, mine| {
-            for (k, out) in mine.iter_mut().enumerate() {
-                sum_part(first + k, out);
-            }
-        });
+        for_each_item(team, &mut parts, 1, sum_part);
         for (s, m) in self.blocks.iter_mut().enumerate() {
             *m = parts.iter().fold(Mat3::ZERO, |acc, p| acc + p[s]);
         }

@@ -27,7 +27,7 @@ use super::block_lanes::pair_entries;
 use super::coarse_grid::CoarseGrid;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
-use crate::thread_team::{ThreadTeam, for_each_item, for_each_part, part_count};
+use crate::thread_team::{ThreadTeam, for_each_item};
 use crate::xpbd::lanes::{LANES, Lane, M3, V3, store_vec};
 
 /// Partial sums of a refresh: a fixed count, so the result does not depend on the
@@ -220,14 +220,11 @@ impl CoarseAssembly {
     ) {
         let mut parts = std::mem::take(&mut self.parts);
         let this = &*self;
-        let count = part_count(team, PARTS, 1);
-        for_each_part(team, &mut parts, count, |first, mine| {
-            for (k, sums) in mine.iter_mut().enumerate() {
-                sums.iter_mut().for_each(|s| *s = [0.0; 9]);
-                let mut acc = Vec::new();
-                for g in &this.groups[this.part_groups[first + k].clone()] {
-                    this.add_group(g, &tangent, &mut acc, sums);
-                }
+        for_each_item(team, &mut parts, 1, |k, sums| {
+            sums.iter_mut().for_each(|s| *s = [0.0; 9]);
+            let mut acc = Vec::new();
+            for g in &this.groups[this.part_groups[k].clone()] {
+                this.add_group(g, &tangent, &mut acc, sums);
             }
         });
         let sums = &parts;

@@ -10,7 +10,7 @@ use super::product_parts::ProductParts;
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::material::Lame;
-use crate::thread_team::{ThreadTeam, for_each_item, for_each_part, for_each_zip2, part_count};
+use crate::thread_team::{ThreadTeam, for_each_item, for_each_zip2};
 use crate::vbd::{energy_density, piola};
 use crate::xpbd::displacement_gradient;
 use crate::xpbd::lanes::LANES;
@@ -152,7 +152,7 @@ impl TetEvals {
         parts: &mut ProductParts,
     ) {
         let (parts, ranges) = parts.split();
-        let run = |(k, sums): (usize, &mut Vec<Vec3A>)| {
+        let run = |k: usize, sums: &mut Vec<Vec3A>| {
             sums[ranges[k].clone()].fill(Vec3A::ZERO);
             let mine = ProductParts::chunks(active, k);
             match self {
@@ -176,12 +176,7 @@ impl TetEvals {
                 }
             }
         };
-        let count = part_count(at.team, parts.len(), 1);
-        for_each_part(at.team, parts, count, |first, mine| {
-            for (k, sums) in mine.iter_mut().enumerate() {
-                run((first + k, sums));
-            }
-        });
+        for_each_item(at.team, parts, 1, run);
     }
 }
 
