@@ -93,6 +93,42 @@ impl FramePacer {
     /// The plan for the display frame shown at `display_time` (s, the runtime's predicted
     /// display time), `display_period` s after the previous one.
     pub fn plan(&mut self, display_time: f64, display_period: f64) -> FramePlan {
+        self.advance_to(display_time, display_period);
+        let owed = self.owed();
+        self.take(owed, display_period)
+    }
+
+    /// The simulation thread's plan at `now` (s on its clock), the display's newest pose
+    /// `fresh` when no frame has been stepped with it yet. The thread steps a frame as
+    /// soon as a new pose arrives instead of on its own clock, so the tissue answers the
+    /// pose a display period sooner: with a fresh pose a frame due within one frame is
+    /// stepped now (simulated time then leads real time by at most a frame), and with a
+    /// pose already stepped with, one owed frame waits up to a frame longer for the next
+    /// (a display slower than the simulation leaves it a frame behind, stepping on its own
+    /// clock). Over time the frames are the scene's rate either way.
+    pub fn plan_on_thread(&mut self, now: f64, fresh: bool) -> FramePlan {
+        let dt = self.cfg.sim_dt;
+        self.advance_to(now, dt);
+        let owed = self.owed();
+        let frames = match fresh {
+            true if self.accumulator >= -1e-9 => owed.max(1),
+            true => owed,
+            false => owed.saturating_sub(1),
+        };
+        self.take(frames, dt)
+    }
+
+    /// How long the simulation thread may wait for the display's next pose before
+    /// [`FramePacer::plan_on_thread`] plans a frame with the pose it has, s (0: now). A
+    /// fresh pose that came while the simulation was a frame ahead waits for the next one
+    /// (which will find it due) rather than start a frame late into the display's period.
+    pub fn until_due_on_thread(&self, fresh: bool) -> f64 {
+        let due = if fresh { 1.0 } else { 2.0 };
+        (due * self.cfg.sim_dt - self.accumulator).max(0.0)
+    }
+
+    /// Add the display time elapsed since the last plan.
+    fn advance_to(&mut self, display_time: f64, display_period: f64) {
         let elapsed = match self.last_display_time {
             Some(t) if display_time > t => display_time - t,
             Some(_) => 0.0,
@@ -100,8 +136,20 @@ impl FramePacer {
         };
         self.last_display_time = Some(display_time);
         self.accumulator += elapsed;
+    }
+
+    /// Whole frames owed.
+    fn owed(&self) -> u32 {
+        ((self.accumulator + 1e-9) / self.cfg.sim_dt)
+            .floor()
+            .max(0.0) as u32
+    }
+
+    /// Step `frames` (at most the catch-up limit, the rest given up) at the substeps that
+    /// fit `display_period`'s budget; fewer frames, their time given up, where even the
+    /// fewest substeps do not fit.
+    fn take(&mut self, mut frames: u32, display_period: f64) -> FramePlan {
         let dt = self.cfg.sim_dt;
-        let mut frames = ((self.accumulator + 1e-9) / dt).floor() as u32;
         if frames > self.cfg.max_sim_frames {
             let extra = (frames - self.cfg.max_sim_frames) as f64 * dt;
             self.dropped += extra;
@@ -247,5 +295,87 @@ mod tests {
         let plan = p.plan(1.5 * dt, 0.25 * dt);
         assert_eq!(plan.sim_frames, 1);
         assert!((p.until_next_frame() - 0.5 * dt).abs() < 1e-9);
+    }
+
+    /// The simulation thread of a 60 Hz scene beside a 72 Hz display, its frames taking
+    /// `step` s: it plans when a pose arrives (each display period) and again when a
+    /// frame ends or its wait runs out. Returns, per frame stepped, the display frame
+    /// whose pose it started on and how long after that pose's arrival it started.
+    fn thread_beside_display(step: f64, display_hz: f64) -> Vec<(u64, f64)> {
+        let mut p = FramePacer::new(cfg());
+        let period = 1.0 / display_hz;
+        let (mut now, mut stepped, mut started) = (0.0f64, None, Vec::new());
+        while now < 1.0 {
+            let newest = (now / period + 1e-9).floor() as u64;
+            let fresh = stepped != Some(newest);
+            let plan = p.plan_on_thread(now, fresh);
+            if plan.sim_frames > 0 {
+                for _ in 0..plan.sim_frames {
+                    started.push((newest, now - newest as f64 * period));
+                }
+                stepped = Some(newest);
+                now += step * plan.sim_frames as f64;
+            } else {
+                // Woken by the next pose or when a frame falls due, whichever is first.
+                let next_pose = (newest + 1) as f64 * period;
+                now = next_pose.min(now + p.until_due_on_thread(fresh).max(1e-6));
+            }
+        }
+        started
+    }
+
+    #[test]
+    fn on_its_thread_a_fast_simulation_steps_as_each_pose_arrives() {
+        // 6 ms frames: 60 frames in the second, every one started the moment a display
+        // frame's pose arrived (so the tissue answers it by the next display frame), and
+        // never two on one pose: the display's 72 poses give 60 frames, the scene's rate.
+        let started = thread_beside_display(0.006, 72.0);
+        assert!((59..=61).contains(&started.len()), "{}", started.len());
+        assert!(
+            started.iter().all(|&(_, late)| late < 1e-6),
+            "a frame waited for its own clock: {started:?}"
+        );
+        let mut poses: Vec<u64> = started.iter().map(|s| s.0).collect();
+        poses.dedup();
+        assert_eq!(poses.len(), started.len(), "two frames on one pose");
+    }
+
+    #[test]
+    fn on_its_thread_a_slower_display_leaves_the_simulation_its_own_rate() {
+        // A 20 Hz display (Monado's null compositor): the frames between its poses are
+        // stepped on the thread's own clock, a frame behind it, and the second still
+        // holds the scene's 60 frames.
+        let started = thread_beside_display(0.002, 20.0);
+        assert!((58..=61).contains(&started.len()), "{}", started.len());
+        // Each pose stepped with at once (the frame it finds owed, a frame late, and the
+        // one due: two of the three a pose spans), the third between poses, not caught up
+        // on the next pose.
+        let on_pose = started.iter().filter(|&&(_, late)| late < 1e-6).count();
+        assert!(
+            (20..=42).contains(&on_pose),
+            "{on_pose} frames started on a pose"
+        );
+    }
+
+    #[test]
+    fn on_its_thread_a_pose_already_stepped_with_waits_a_frame_for_the_next() {
+        let mut p = FramePacer::new(cfg());
+        let dt = 1.0 / 60.0;
+        assert_eq!(p.plan_on_thread(0.0, true).sim_frames, 1, "the first frame");
+        // Half a frame later with the same pose: nothing due yet.
+        assert_eq!(p.plan_on_thread(0.5 * dt, false).sim_frames, 0);
+        // A frame and a half later the next frame is owed, but with the old pose it
+        // waits up to a frame for a new one...
+        assert_eq!(p.plan_on_thread(1.5 * dt, false).sim_frames, 0);
+        assert!((p.until_due_on_thread(false) - 0.5 * dt).abs() < 1e-9);
+        // ...which, when it comes, is stepped at once.
+        assert_eq!(p.plan_on_thread(1.6 * dt, true).sim_frames, 1);
+        // The next new pose steps the frame due at 2 dt early, at 1.7 dt...
+        assert_eq!(p.plan_on_thread(1.7 * dt, true).sim_frames, 1);
+        // ...and with the simulation ahead of real time, the one after waits for the next
+        // pose (or its own clock) rather than start a frame late into its display period.
+        assert_eq!(p.plan_on_thread(1.8 * dt, true).sim_frames, 0);
+        assert!((p.until_due_on_thread(true) - 1.2 * dt).abs() < 1e-9);
+        assert_eq!(p.dropped_time(), 0.0);
     }
 }

@@ -2,7 +2,10 @@
 //! body ([`LiveSim`]) for the session, steps fixed-dt frames paced to real time by the
 //! frame pacer (substeps cut first where the body has them, then simulated time given up
 //! when a frame costs more than its dt), each with the display's newest command, and
-//! publishes every completed frame for the display to draw. The display never waits for
+//! publishes every completed frame for the display to draw. A frame starts when a
+//! display frame's new pose arrives, if it falls due within a frame, rather than on the
+//! thread's own clock ([`FramePacer::plan_on_thread`]): a step shorter than the display
+//! period then shows its pose's effect at the next display frame. The display never waits for
 //! it; when it is slower than real time it falls behind, the display does not. Its
 //! errors and panics end the session with the error; the body comes back to the session
 //! however it ended (its recorded stroke and report are still saved).
@@ -231,13 +234,17 @@ impl Loop<'_> {
                 live.reset()?;
                 self.publish(live);
             }
-            let mut plan = self.pacer.plan(clock.elapsed().as_secs_f64(), dt);
             if cmd.paused || live.stroke_done() {
-                plan.sim_frames = 0;
+                self.pacer.plan(clock.elapsed().as_secs_f64(), dt);
+                self.sleep(self.pacer.until_next_frame(), dt);
+                continue;
             }
+            let fresh = live.last_command.map(|(frame, _)| frame) != Some(cmd.stamp.0);
+            let plan = self
+                .pacer
+                .plan_on_thread(clock.elapsed().as_secs_f64(), fresh);
             if plan.sim_frames == 0 {
-                let wait = self.pacer.until_next_frame().clamp(0.0005, dt);
-                std::thread::sleep(Duration::from_secs_f64(wait));
+                self.wait(&cmd, fresh, dt);
                 continue;
             }
             let started = Instant::now();
@@ -246,6 +253,22 @@ impl Loop<'_> {
             self.pacer.record(plan, started.elapsed().as_secs_f64());
         }
         Ok(())
+    }
+
+    /// With no frame to step: wait until one falls due or the display posts a pose from
+    /// a newer display frame than `cmd`'s (`fresh`: `cmd` not stepped with yet).
+    fn wait(&self, cmd: &BodyCommand, fresh: bool, dt: f64) {
+        let until = self
+            .pacer
+            .until_due_on_thread(fresh)
+            .clamp(0.0005, 2.0 * dt);
+        let frame = cmd.stamp.0;
+        (self.link.commands).wait_for(Duration::from_secs_f64(until), |c| c.stamp.0 != frame);
+    }
+
+    /// Sleep `s` seconds (at least half a millisecond, at most `dt`).
+    fn sleep(&self, s: f64, dt: f64) {
+        std::thread::sleep(Duration::from_secs_f64(s.clamp(0.0005, dt)));
     }
 
     fn command(&self) -> BodyCommand {
