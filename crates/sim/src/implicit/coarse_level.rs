@@ -1,5 +1,5 @@
 //! The coarse level of the Newton step's two-level preconditioner as the CPU
-//! (`workspace.rs`) and the device (`crate::gpu::newton`) both keep it: the coarse grid,
+//! (`two_level.rs`) and the device (`crate::gpu::newton`) both keep it: the coarse grid,
 //! its Galerkin matrix and factor, the refresh policy, the release rule and the rebuild
 //! after a cut (docs/physics-notes.md, "The implicit scheme", "The coarse level after a
 //! cut").

@@ -1,7 +1,7 @@
 //! The Newton step's tet evaluation eight tets at a time in SIMD lanes: for each tet its
 //! nodal forces `V P b_a`, the diagonal blocks of its Hessian, its energy `V Ψ` and its
 //! stress tangent, at the current iterate. The same formulas as the scalar evaluation
-//! (`workspace.rs`, `Hessian::evaluate`, with [`crate::vbd::piola`],
+//! (`tet_evals.rs`, `scalar_eval`, with [`crate::vbd::piola`],
 //! [`crate::vbd::energy_density`] and [`super::TetTangent::at`]), which stays the reference
 //! (`cpu_kernel: Scalar`) and is tested equal to it up to rounding; built on the XPBD
 //! lanes' strain algebra (`crate::xpbd::rest_free_lanes`), in one AVX register per value

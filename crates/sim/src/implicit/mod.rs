@@ -13,6 +13,7 @@ mod coarse_pieces;
 mod coarse_rebuild;
 mod coarse_system;
 mod eval_lanes;
+mod hessian;
 mod newton_report;
 mod params;
 mod pcg;
@@ -21,6 +22,7 @@ mod product_parts;
 mod rest_tet;
 mod tet_evals;
 mod tet_tangent;
+mod two_level;
 mod workspace;
 
 pub use coarse_grid::CoarseGrid;

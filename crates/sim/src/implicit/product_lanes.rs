@@ -2,7 +2,7 @@
 //! the XPBD lanes' algebra (`crate::xpbd::lanes`): in one AVX register per value where
 //! the CPU has AVX2 (detected at run time, so the portable build uses it), else in
 //! `wide::f32x8`. The same operations in the same order as the scalar product
-//! (`workspace.rs`, `Hessian::scalar_products`), which stays the reference
+//! (`tet_evals.rs`, `scalar_product`), which stays the reference
 //! (`cpu_kernel: Scalar`) and is tested equal to it up to rounding.
 
 use glam::{Mat3, Vec3, Vec3A};

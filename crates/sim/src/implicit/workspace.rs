@@ -13,61 +13,28 @@
 //! ([`BlockMatrix`]), plus a coarse-grid correction `P A_c⁻¹ Pᵀ` ([`super::CoarseLevel`]). A
 //! backtracking line search on `G` keeps every step a descent.
 
-use glam::{Mat3, Vec3, Vec3A};
+use glam::{Mat3, Vec3};
 
 use super::block_matrix::BlockMatrix;
 use super::coarse_level::CoarseLevel;
 use super::coarse_system::CoarseError;
+use super::hessian::Hessian;
 use super::newton_report::NewtonReport;
 use super::params::{NewtonParams, Smoother};
 use super::pcg::{dot, pcg};
 use super::product_parts::ProductParts;
 use super::rest_tet::RestTet;
-use super::tet_evals::{Iterate, TetEvals, active_chunks, for_each};
+use super::tet_evals::TetEvals;
+use super::two_level::TwoLevel;
 use crate::material::Lame;
 use crate::mesh::TetMesh;
-use crate::thread_team::{ThreadTeam, for_each_zip2};
+use crate::thread_team::ThreadTeam;
 use crate::vbd::shape_gradients;
-use crate::xpbd::lanes::LANES;
 
-/// Fewest nodes in a part of a node pass on the team.
-const CHUNK: usize = 256;
 /// Armijo constant of the line search.
 const ARMIJO: f64 = 1e-4;
 /// Most halvings of a Newton step before the step is abandoned.
 const MAX_HALVINGS: u32 = 8;
-
-/// The Hessian of `G` applied matrix-free.
-struct Hessian {
-    tets: Vec<RestTet>,
-    b: Vec<[Vec3; 4]>,
-    inc_offsets: Vec<u32>,
-    inc: Vec<(u32, u8)>,
-    mass: Vec<f32>,
-    inv_h2: f32,
-    lame: Lame,
-    /// The tets' evaluations, in chunks of eight for the SIMD kernels or tet by tet
-    /// (the reference).
-    evals: TetEvals,
-    /// The tets' product forces summed per node, one vector per fixed range of tets.
-    product_parts: ProductParts,
-    /// The chunks of eight tets whose forces reach a free node (found once a step).
-    active: Vec<u32>,
-    /// Per chunk, whether none of its tets reaches a free node (empty: none known).
-    fixed: Vec<bool>,
-}
-
-/// Block Jacobi plus the coarse correction.
-struct TwoLevel {
-    diag_inv: Vec<Mat3>,
-    level: CoarseLevel,
-    /// The assembled Hessian for the Gauss–Seidel smoother (`None`: block Jacobi).
-    matrix: Option<BlockMatrix>,
-    /// The coarse right-hand side and solution (f64, three per coarse node).
-    rhs: Vec<f64>,
-    /// The coarse solution in f32 (each value rounded once), what the fine nodes read.
-    coarse: Vec<Vec3A>,
-}
 
 /// Buffers and the preconditioner of the implicit scheme for one body.
 pub struct NewtonWorkspace {
@@ -322,198 +289,6 @@ fn reach(d: &[Vec3], free: &[bool]) -> f32 {
         .map(|(d, _)| d.length_squared())
         .fold(0.0, f32::max)
         .sqrt()
-}
-
-impl Hessian {
-    /// Forces, diagonal blocks, tangents and energy of every live tet at `u` (but those of
-    /// the chunks [`Hessian::find_active`] found fixed, whose values at the step's start
-    /// hold: their nodes do not move); returns `G(u)`.
-    fn evaluate(
-        &mut self,
-        u: &[Vec3],
-        y: &[Vec3],
-        live: &[bool],
-        free: &[bool],
-        team: Option<&ThreadTeam>,
-    ) -> f64 {
-        let at = Iterate {
-            u,
-            live,
-            lame: self.lame,
-            b: &self.b,
-            team,
-        };
-        self.evals.evaluate(&self.tets, at, true, &self.fixed);
-        self.total(u, y, free)
-    }
-
-    /// `G(u)` alone: only the tets' energies are updated (their forces, diagonal blocks
-    /// and tangents stay those of the last [`Hessian::evaluate`]); the same value
-    /// `evaluate` returns, to the bit.
-    fn energy(
-        &mut self,
-        u: &[Vec3],
-        y: &[Vec3],
-        live: &[bool],
-        free: &[bool],
-        team: Option<&ThreadTeam>,
-    ) -> f64 {
-        let at = Iterate {
-            u,
-            live,
-            lame: self.lame,
-            b: &self.b,
-            team,
-        };
-        self.evals.evaluate(&self.tets, at, false, &self.fixed);
-        self.total(u, y, free)
-    }
-
-    /// `G` from the tets' energies and the inertia at `u`.
-    fn total(&self, u: &[Vec3], y: &[Vec3], free: &[bool]) -> f64 {
-        let elastic = self.evals.elastic_energy();
-        let inertia: f64 = (0..u.len())
-            .filter(|&i| free[i])
-            .map(|i| (self.mass[i] * (u[i] - y[i]).length_squared()) as f64)
-            .sum();
-        elastic + 0.5 * self.inv_h2 as f64 * inertia
-    }
-
-    /// `∂G/∂x` and the diagonal block of `∇²G` at node `i` from the tet evaluations in
-    /// hand: `m/h² (u − y)` and `m/h² I` plus its tets' corner forces and blocks.
-    fn node_sums(&self, u: &[Vec3], y: &[Vec3], i: usize) -> (Vec3, Mat3) {
-        let m = self.mass[i] * self.inv_h2;
-        let mut g = (u[i] - y[i]) * m;
-        let mut d = Mat3::IDENTITY * m;
-        for &(t, a) in self.incident(i) {
-            g += self.evals.force(t as usize, a as usize);
-            d += self.evals.diag(t as usize, a as usize);
-        }
-        (g, d)
-    }
-
-    /// `∇G` and the inverted diagonal blocks of `∇²G` per node (zero at fixed nodes).
-    fn gather_gradient(
-        &self,
-        u: &[Vec3],
-        y: &[Vec3],
-        free: &[bool],
-        gradient: &mut [Vec3],
-        diag_inv: &mut [Mat3],
-        team: Option<&ThreadTeam>,
-    ) {
-        let node = |i: usize, g: &mut Vec3, d_inv: &mut Mat3| {
-            (*g, *d_inv) = if free[i] {
-                let (g, d) = self.node_sums(u, y, i);
-                (g, d.inverse())
-            } else {
-                (Vec3::ZERO, Mat3::ZERO)
-            };
-        };
-        for_each_zip2(team, (gradient, diag_inv), CHUNK, node);
-    }
-
-    /// Find the chunks of tets whose forces reach a free node (what [`Hessian::apply`]
-    /// sums): once a step, as `live` and `free` change only between steps.
-    fn find_active(&mut self, live: &[bool], free: &[bool]) {
-        self.active = active_chunks(&self.tets, live, free);
-        let nodes = self.mass.len();
-        self.product_parts
-            .set_chunks(&self.tets, &self.active, nodes);
-        self.fixed.clear();
-        self.fixed.resize(self.tets.len().div_ceil(LANES), true);
-        for &c in &self.active {
-            self.fixed[c as usize] = false;
-        }
-    }
-
-    /// `out = ∇²G p` (zero at fixed nodes; the chunks of [`Hessian::find_active`]).
-    fn apply(
-        &mut self,
-        p: &[Vec3],
-        out: &mut [Vec3],
-        live: &[bool],
-        free: &[bool],
-        team: Option<&ThreadTeam>,
-    ) {
-        let at = Iterate {
-            u: p,
-            live,
-            lame: self.lame,
-            b: &self.b,
-            team,
-        };
-        let active = &self.active;
-        self.evals
-            .products(&self.tets, at, active, &mut self.product_parts);
-        self.gather_products(p, out, free, team);
-    }
-
-    /// `out = M/h² p +` the tets' forces at each free node, the parts added in order
-    /// (zero at fixed nodes).
-    fn gather_products(
-        &self,
-        p: &[Vec3],
-        out: &mut [Vec3],
-        free: &[bool],
-        team: Option<&ThreadTeam>,
-    ) {
-        let (parts, mass, inv_h2) = (&self.product_parts, &self.mass, self.inv_h2);
-        let node = |i: usize, o: &mut Vec3| {
-            if !free[i] {
-                *o = Vec3::ZERO;
-                return;
-            }
-            let inertia = Vec3A::from(p[i] * (mass[i] * inv_h2));
-            *o = parts.add_at(i, inertia).into();
-        };
-        for_each(team, out, node);
-    }
-
-    /// The (tet, corner) pairs of node `i`.
-    fn incident(&self, i: usize) -> &[(u32, u8)] {
-        &self.inc[self.inc_offsets[i] as usize..self.inc_offsets[i + 1] as usize]
-    }
-}
-
-impl TwoLevel {
-    /// `z = S r + P A_c⁻¹ Pᵀ r` (additive two-level; zero at fixed nodes), `S` one
-    /// symmetric Gauss–Seidel sweep where the smoother is `GaussSeidel` and `smooth`, else
-    /// block Jacobi `D⁻¹`; the fine part, the prolongation and the mask in one node pass.
-    fn apply(
-        &mut self,
-        r: &[Vec3],
-        z: &mut [Vec3],
-        free: &[bool],
-        team: Option<&ThreadTeam>,
-        smooth: bool,
-    ) {
-        let level = &self.level;
-        level.grid.restrict(r, &mut self.rhs, team);
-        level.system.solve(&mut self.rhs);
-        self.coarse.clear();
-        self.coarse.extend(
-            self.rhs
-                .chunks_exact(3)
-                .map(|v| Vec3A::new(v[0] as f32, v[1] as f32, v[2] as f32)),
-        );
-        let smoothed = match (&self.matrix, smooth) {
-            (Some(m), true) => {
-                m.symmetric_gauss_seidel(r, z, free);
-                true
-            }
-            _ => false,
-        };
-        let (grid, coarse, diag_inv) = (&level.grid, &self.coarse, &self.diag_inv);
-        for_each(team, z, |i, z| {
-            *z = if !free[i] {
-                Vec3::ZERO
-            } else {
-                let fine = if smoothed { *z } else { diag_inv[i] * r[i] };
-                grid.add_prolonged(i, coarse, fine.into()).into()
-            };
-        });
-    }
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! The host side of the GPU Newton solver's coarse level: the same coarse grid, Galerkin
 //! matrix, refresh policy and release rule as the CPU's two-level preconditioner
-//! (`crate::implicit`, `TwoLevel` in implicit/workspace.rs), kept on the host, and what
+//! (`crate::implicit`, `TwoLevel` in implicit/two_level.rs), kept on the host, and what
 //! the device applies of it: `P` as per-node weights and its transpose, and `A_c⁻¹` as a
 //! dense matrix computed from the sparse Cholesky factor whenever the factor changes
 //! (docs/physics-notes.md, "The implicit scheme on the GPU").

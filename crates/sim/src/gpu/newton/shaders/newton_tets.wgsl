@@ -2,7 +2,7 @@
 // kernels'): the full evaluation at the trial point (energy, corner forces, diagonal
 // blocks, tangent), the energy alone (the line search's halved steps), and the Hessian
 // product's corner forces. CPU twin: Hessian::evaluate, Hessian::energy and
-// Hessian::scalar_products in crates/sim/src/implicit/workspace.rs.
+// Hessian::apply in crates/sim/src/implicit/hessian.rs.
 
 @group(0) @binding(0) var<uniform> NW: Newton;
 @group(0) @binding(1) var<storage, read> tets: array<vec4<u32>>;
