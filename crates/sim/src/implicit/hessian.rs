@@ -7,13 +7,10 @@ use glam::{Mat3, Vec3, Vec3A};
 
 use super::product_parts::ProductParts;
 use super::rest_tet::RestTet;
-use super::tet_evals::{Iterate, TetEvals, active_chunks, for_each};
+use super::tet_evals::{Iterate, MIN_PART, TetEvals, active_chunks, for_each};
 use crate::material::Lame;
 use crate::thread_team::{ThreadTeam, for_each_zip2};
 use crate::xpbd::lanes::LANES;
-
-/// Fewest nodes in a part of a node pass on the team.
-const CHUNK: usize = 256;
 
 /// The Hessian of `G` applied matrix-free.
 pub(super) struct Hessian {
@@ -121,7 +118,7 @@ impl Hessian {
                 (Vec3::ZERO, Mat3::ZERO)
             };
         };
-        for_each_zip2(team, (gradient, diag_inv), CHUNK, node);
+        for_each_zip2(team, (gradient, diag_inv), MIN_PART, node);
     }
 
     /// Find the chunks of tets whose forces reach a free node (what [`Hessian::apply`]

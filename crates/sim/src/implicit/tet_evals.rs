@@ -131,7 +131,7 @@ impl TetEvals {
                         eval_lanes::energy(&rest[c], live, at.u, at.lame, out);
                     }
                 };
-                for_each_zip2(at.team, (evals, tangents), CHUNK / LANES, run);
+                for_each_zip2(at.team, (evals, tangents), MIN_PART / LANES, run);
             }
         }
     }
@@ -247,8 +247,8 @@ fn scalar_eval(
     }
 }
 
-/// Fewest items in a part of a pass on the team.
-const CHUNK: usize = 256;
+/// Fewest items in a part of a pass on the team: nodes, or tets (in chunks of eight).
+pub(super) const MIN_PART: usize = 256;
 
 /// `f(i, &mut out[i])` for every item, on the team's threads where there is one.
 pub(super) fn for_each<T: Send>(
@@ -256,5 +256,5 @@ pub(super) fn for_each<T: Send>(
     out: &mut [T],
     f: impl Fn(usize, &mut T) + Sync,
 ) {
-    for_each_item(team, out, CHUNK, f);
+    for_each_item(team, out, MIN_PART, f);
 }
