@@ -5,10 +5,10 @@
 //! publishes every completed frame for the display to draw. A frame starts when a
 //! display frame's new pose arrives, if it falls due within a frame, rather than on the
 //! thread's own clock ([`FramePacer::plan_on_thread`]): a step shorter than the display
-//! period then shows its pose's effect at the next display frame. The display never waits for
-//! it; when it is slower than real time it falls behind, the display does not. Its
-//! errors and panics end the session with the error; the body comes back to the session
-//! however it ended (its recorded stroke and report are still saved).
+//! period then shows its pose's effect at the next display frame. The display never
+//! waits for it; when it is slower than real time it falls behind, the display does not.
+//! Its errors and panics end the session with the error; the body comes back to the
+//! session however it ended (its recorded stroke and report are still saved).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -263,7 +263,9 @@ impl Loop<'_> {
             .until_due_on_thread(fresh)
             .clamp(0.0005, 2.0 * dt);
         let frame = cmd.stamp.0;
-        (self.link.commands).wait_for(Duration::from_secs_f64(until), |c| c.stamp.0 != frame);
+        self.link
+            .commands
+            .wait_for(Duration::from_secs_f64(until), |c| c.stamp.0 != frame);
     }
 
     /// Sleep `s` seconds (at least half a millisecond, at most `dt`).
