@@ -44,15 +44,7 @@ impl Hessian {
         free: &[bool],
         team: Option<&ThreadTeam>,
     ) -> f64 {
-        let at = Iterate {
-            u,
-            live,
-            lame: self.lame,
-            b: &self.b,
-            team,
-        };
-        self.evals.evaluate(&self.tets, at, true, &self.fixed);
-        self.total(u, y, free)
+        self.evaluate_parts(u, y, (live, free), team, true)
     }
 
     /// `G(u)` alone: only the tets' energies are updated (their forces, diagonal blocks
@@ -66,6 +58,18 @@ impl Hessian {
         free: &[bool],
         team: Option<&ThreadTeam>,
     ) -> f64 {
+        self.evaluate_parts(u, y, (live, free), team, false)
+    }
+
+    /// `G(u)` after evaluating the tets at `u`: everything (`full`) or their energies.
+    fn evaluate_parts(
+        &mut self,
+        u: &[Vec3],
+        y: &[Vec3],
+        (live, free): (&[bool], &[bool]),
+        team: Option<&ThreadTeam>,
+        full: bool,
+    ) -> f64 {
         let at = Iterate {
             u,
             live,
@@ -73,7 +77,7 @@ impl Hessian {
             b: &self.b,
             team,
         };
-        self.evals.evaluate(&self.tets, at, false, &self.fixed);
+        self.evals.evaluate(&self.tets, at, full, &self.fixed);
         self.total(u, y, free)
     }
 
