@@ -14,12 +14,19 @@ use crate::xpbd::lanes::LANES;
 
 /// The Hessian of `G` applied matrix-free.
 pub(super) struct Hessian {
+    /// Every tet's nodes, `Dm⁻¹` and rest volume, in mesh order.
     pub(super) tets: Vec<RestTet>,
+    /// Every tet's shape gradients `b_a`.
     pub(super) b: Vec<[Vec3; 4]>,
+    /// Where each node's (tet, corner) pairs start in `inc` (one more than the nodes).
     pub(super) inc_offsets: Vec<u32>,
+    /// The (tet, corner) pairs of every node, node by node.
     pub(super) inc: Vec<(u32, u8)>,
+    /// Lumped node masses, kg.
     pub(super) mass: Vec<f32>,
+    /// `1/h²` of the step, 1/s².
     pub(super) inv_h2: f32,
+    /// The material's Lamé parameters.
     pub(super) lame: Lame,
     /// The tets' evaluations, in chunks of eight for the SIMD kernels or tet by tet
     /// (the reference).

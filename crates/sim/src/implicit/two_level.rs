@@ -11,7 +11,9 @@ use crate::thread_team::ThreadTeam;
 
 /// Block Jacobi plus the coarse correction.
 pub(super) struct TwoLevel {
+    /// Each node's inverted diagonal block of `∇²G` (zero at fixed nodes).
     pub(super) diag_inv: Vec<Mat3>,
+    /// The coarse grid, its matrix and factor.
     pub(super) level: CoarseLevel,
     /// The assembled Hessian for the Gauss–Seidel smoother (`None`: block Jacobi).
     pub(super) matrix: Option<BlockMatrix>,
