@@ -391,6 +391,7 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
         for r in &rows {
             assert!(low(r[3]) > 0.0, "simulation frames a second: {out}");
             assert!(low(r[4]) > 0.0 && low(r[5]) >= low(r[4]), "latency: {out}");
+            assert!((0.0..=100.0).contains(&low(r[6])), "within: {out}");
         }
     } else {
         assert!(out.contains("Headset: not measured: "), "{out}");
