@@ -4,13 +4,15 @@
 //! step); a reader with nothing to do may sleep until a value it wants is put.
 
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// The newest value put, shared.
 pub struct Latest<T> {
     slot: Mutex<Option<Arc<T>>>,
     /// Signalled on every put.
     put: Condvar,
+    /// When the newest value was put.
+    put_at: Mutex<Option<Instant>>,
 }
 
 impl<T> Default for Latest<T> {
@@ -18,6 +20,7 @@ impl<T> Default for Latest<T> {
         Latest {
             slot: Mutex::new(None),
             put: Condvar::new(),
+            put_at: Mutex::new(None),
         }
     }
 }
@@ -28,7 +31,14 @@ impl<T> Latest<T> {
         let value = Arc::new(value);
         // A poisoned lock only means a thread panicked elsewhere; the slot is a pointer.
         *self.slot.lock().unwrap_or_else(PoisonError::into_inner) = Some(value);
+        *self.put_at.lock().unwrap_or_else(PoisonError::into_inner) = Some(Instant::now());
         self.put.notify_all();
+    }
+
+    /// How long ago the newest value was put (`None`: none yet).
+    pub fn age(&self) -> Option<Duration> {
+        let at = *self.put_at.lock().unwrap_or_else(PoisonError::into_inner);
+        at.map(|t| t.elapsed())
     }
 
     /// Sleep until the newest value is one `wanted` accepts or `timeout` has passed; the
@@ -63,6 +73,18 @@ mod tests {
         l.put(2);
         assert_eq!(*l.get().unwrap(), 2);
         assert_eq!(*l.get().unwrap(), 2, "reading does not take it away");
+    }
+
+    #[test]
+    fn the_age_is_the_time_since_the_newest_put() {
+        let l = Latest::default();
+        assert!(l.age().is_none());
+        l.put(1);
+        std::thread::sleep(Duration::from_millis(20));
+        let old = l.age().unwrap();
+        assert!(old >= Duration::from_millis(20), "{old:?}");
+        l.put(2);
+        assert!(l.age().unwrap() < old, "a put does not renew the age");
     }
 
     #[test]

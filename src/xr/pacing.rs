@@ -184,6 +184,25 @@ impl FramePacer {
     }
 }
 
+/// How long a simulation thread about to step with a pose `age` s old should wait for the
+/// display's next pose instead, s (`None`: start now): only where a step of `step` s shows
+/// at the same display frame either way, as display frames of `period` s take the newest
+/// state when their pose arrives. Started now, the step ends `age + step` after its pose
+/// arrived and shows at the first display frame after that; started on the next pose, at
+/// `period + step`; the two are the same frame when `age` exceeds `⌈step/period⌉·period −
+/// step` (with [`ALIGN_MARGIN`] for the step's estimate). The frame is then shown from a
+/// pose up to a period newer, at the cost of the wait, which the thread does not step in.
+pub fn wait_for_next_pose(age: f64, step: f64, period: f64) -> Option<f64> {
+    if !(period > 0.0 && step > 0.0) || age >= period {
+        return None;
+    }
+    let slack = (step / period).ceil() * period - step;
+    (age > slack + ALIGN_MARGIN).then_some(period - age + ALIGN_MARGIN)
+}
+
+/// What [`wait_for_next_pose`] allows for a step's time differing from its estimate, s.
+pub const ALIGN_MARGIN: f64 = 0.001;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -377,5 +396,27 @@ mod tests {
         assert_eq!(p.plan_on_thread(1.8 * dt, true).sim_frames, 0);
         assert!((p.until_due_on_thread(true) - 1.2 * dt).abs() < 1e-9);
         assert_eq!(p.dropped_time(), 0.0);
+    }
+
+    #[test]
+    fn a_step_waits_for_the_next_pose_only_where_it_shows_at_the_same_frame() {
+        let p = 1.0 / 72.0;
+        // A 20 ms step spans two display periods (27.8 ms) with 7.8 ms to spare: a pose
+        // 10 ms old would show at the third frame after it if started now, at the same
+        // frame (two after the next pose) if started on the next pose, which comes in 3.9.
+        let w = wait_for_next_pose(0.010, 0.020, p).unwrap();
+        assert!((w - (p - 0.010 + ALIGN_MARGIN)).abs() < 1e-12, "{w}");
+        // A pose 5 ms old: started now the step shows at the second frame; waiting would
+        // make it the third.
+        assert_eq!(wait_for_next_pose(0.005, 0.020, p), None);
+        // Within the margin of the spare time: start now.
+        assert_eq!(wait_for_next_pose(0.0085, 0.020, p), None);
+        // A 6 ms step with a fresh pose: start now; with a pose 9 ms old (it would show at
+        // the second frame either way), wait.
+        assert_eq!(wait_for_next_pose(0.0, 0.006, p), None);
+        assert!(wait_for_next_pose(0.009, 0.006, p).is_some());
+        // No estimate, or a pose older than a period (the display stalled): start now.
+        assert_eq!(wait_for_next_pose(0.010, 0.0, p), None);
+        assert_eq!(wait_for_next_pose(0.020, 0.020, p), None);
     }
 }

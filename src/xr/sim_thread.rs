@@ -5,8 +5,9 @@
 //! publishes every completed frame for the display to draw. A frame starts when a
 //! display frame's new pose arrives, if it falls due within a frame, rather than on the
 //! thread's own clock ([`FramePacer::plan_on_thread`]): a step shorter than the display
-//! period then shows its pose's effect at the next display frame. The display never
-//! waits for it; when it is slower than real time it falls behind, the display does not.
+//! period then shows its pose's effect at the next display frame; behind, it waits for
+//! the next pose where its step would show at the same display frame either way
+//! ([`wait_for_next_pose`]). The display never waits for it; when it is slower than real time it falls behind, the display does not.
 //! Its errors and panics end the session with the error; the body comes back to the
 //! session however it ended (its recorded stroke and report are still saved).
 
@@ -16,7 +17,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use super::pacing::FramePacer;
+use super::pacing::{FramePacer, wait_for_next_pose};
 use anyhow::{Result, anyhow};
 use incise_sim::contact::ToolPose;
 
@@ -181,6 +182,8 @@ fn run(mut live: LiveSim, nominal: bool, link: &Link) -> ThreadEnd {
         pacer,
         resets_seen: 0,
         started: None,
+        seen: None,
+        period: None,
     };
     let ended = catch_unwind(AssertUnwindSafe(|| sim.run(&mut live))).unwrap_or_else(|p| {
         Err(anyhow!(
@@ -213,6 +216,10 @@ struct Loop<'l> {
     pacer: FramePacer,
     resets_seen: u64,
     started: Option<Instant>,
+    /// The display frame and predicted display time of the last pose stepped with.
+    seen: Option<CommandStamp>,
+    /// The display period those give, s.
+    period: Option<f64>,
 }
 
 impl Loop<'_> {
@@ -247,6 +254,9 @@ impl Loop<'_> {
                 self.wait(&cmd, fresh, dt);
                 continue;
             }
+            if fresh {
+                self.align_with_next_pose(&cmd, live.last_ms * 1e-3);
+            }
             let started = Instant::now();
             live.set_substeps(plan.substeps)?;
             self.step_frames(live, plan.sim_frames)?;
@@ -266,6 +276,26 @@ impl Loop<'_> {
         self.link
             .commands
             .wait_for(Duration::from_secs_f64(until), |c| c.stamp.0 != frame);
+    }
+
+    /// Before a step with the pose of `cmd` (the last step took `step` s): wait for the
+    /// next pose where the step would show at the same display frame either way
+    /// ([`wait_for_next_pose`]); the step then takes the newer one.
+    fn align_with_next_pose(&mut self, cmd: &BodyCommand, step: f64) {
+        let (frame, time) = cmd.stamp;
+        if let Some((f0, t0)) = self.seen.filter(|&(f0, _)| frame > f0) {
+            self.period = Some((time - t0) / (frame - f0) as f64);
+        }
+        self.seen = Some((frame, time));
+        let age = self.link.commands.age().map_or(0.0, |a| a.as_secs_f64());
+        let Some(period) = self.period else {
+            return;
+        };
+        if let Some(wait) = wait_for_next_pose(age, step, period) {
+            self.link
+                .commands
+                .wait_for(Duration::from_secs_f64(wait), |c| c.stamp.0 != frame);
+        }
     }
 
     /// Sleep `s` seconds (at least half a millisecond, at most `dt`).
