@@ -8,11 +8,10 @@ use std::time::{Duration, Instant};
 
 /// The newest value put, shared.
 pub struct Latest<T> {
-    slot: Mutex<Option<Arc<T>>>,
+    /// The newest value and when it was put.
+    slot: Mutex<Option<(Arc<T>, Instant)>>,
     /// Signalled on every put.
     put: Condvar,
-    /// When the newest value was put.
-    put_at: Mutex<Option<Instant>>,
 }
 
 impl<T> Default for Latest<T> {
@@ -20,7 +19,6 @@ impl<T> Default for Latest<T> {
         Latest {
             slot: Mutex::new(None),
             put: Condvar::new(),
-            put_at: Mutex::new(None),
         }
     }
 }
@@ -30,15 +28,14 @@ impl<T> Latest<T> {
     pub fn put(&self, value: T) {
         let value = Arc::new(value);
         // A poisoned lock only means a thread panicked elsewhere; the slot is a pointer.
-        *self.slot.lock().unwrap_or_else(PoisonError::into_inner) = Some(value);
-        *self.put_at.lock().unwrap_or_else(PoisonError::into_inner) = Some(Instant::now());
+        *self.slot.lock().unwrap_or_else(PoisonError::into_inner) = Some((value, Instant::now()));
         self.put.notify_all();
     }
 
     /// How long ago the newest value was put (`None`: none yet).
     pub fn age(&self) -> Option<Duration> {
-        let at = *self.put_at.lock().unwrap_or_else(PoisonError::into_inner);
-        at.map(|t| t.elapsed())
+        let slot = self.slot.lock().unwrap_or_else(PoisonError::into_inner);
+        slot.as_ref().map(|(_, at)| at.elapsed())
     }
 
     /// Sleep until the newest value is one `wanted` accepts or `timeout` has passed; the
@@ -47,17 +44,17 @@ impl<T> Latest<T> {
         let slot = self.slot.lock().unwrap_or_else(PoisonError::into_inner);
         let (slot, _) = self
             .put
-            .wait_timeout_while(slot, timeout, |v| !v.as_deref().is_some_and(&wanted))
+            .wait_timeout_while(slot, timeout, |v| {
+                !v.as_ref().is_some_and(|(v, _)| wanted(v))
+            })
             .unwrap_or_else(PoisonError::into_inner);
-        slot.clone()
+        slot.as_ref().map(|(v, _)| Arc::clone(v))
     }
 
     /// The newest value, if any was put.
     pub fn get(&self) -> Option<Arc<T>> {
-        self.slot
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .clone()
+        let slot = self.slot.lock().unwrap_or_else(PoisonError::into_inner);
+        slot.as_ref().map(|(v, _)| Arc::clone(v))
     }
 }
 

@@ -7,9 +7,10 @@
 //! thread's own clock ([`FramePacer::plan_on_thread`]): a step shorter than the display
 //! period then shows its pose's effect at the next display frame; behind, it waits for
 //! the next pose where its step would show at the same display frame either way
-//! ([`wait_for_next_pose`]). The display never waits for it; when it is slower than real time it falls behind, the display does not.
-//! Its errors and panics end the session with the error; the body comes back to the
-//! session however it ended (its recorded stroke and report are still saved).
+//! ([`wait_for_next_pose`]). The display never waits for it; when it is slower than real
+//! time it falls behind, the display does not. Its errors and panics end the session
+//! with the error; the body comes back to the session however it ended (its recorded
+//! stroke and report are still saved).
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -182,7 +183,6 @@ fn run(mut live: LiveSim, nominal: bool, link: &Link) -> ThreadEnd {
         pacer,
         resets_seen: 0,
         started: None,
-        seen: None,
         period: None,
     };
     let ended = catch_unwind(AssertUnwindSafe(|| sim.run(&mut live))).unwrap_or_else(|p| {
@@ -216,9 +216,7 @@ struct Loop<'l> {
     pacer: FramePacer,
     resets_seen: u64,
     started: Option<Instant>,
-    /// The display frame and predicted display time of the last pose stepped with.
-    seen: Option<CommandStamp>,
-    /// The display period those give, s.
+    /// The display period, s, from the stamps of the poses stepped with.
     period: Option<f64>,
 }
 
@@ -255,7 +253,7 @@ impl Loop<'_> {
                 continue;
             }
             if fresh {
-                self.align_with_next_pose(&cmd, live.last_ms * 1e-3);
+                self.align_with_next_pose(&cmd, live.last_command, live.last_ms * 1e-3);
             }
             let started = Instant::now();
             live.set_substeps(plan.substeps)?;
@@ -278,15 +276,20 @@ impl Loop<'_> {
             .wait_for(Duration::from_secs_f64(until), |c| c.stamp.0 != frame);
     }
 
-    /// Before a step with the pose of `cmd` (the last step took `step` s): wait for the
-    /// next pose where the step would show at the same display frame either way
-    /// ([`wait_for_next_pose`]); the step then takes the newer one.
-    fn align_with_next_pose(&mut self, cmd: &BodyCommand, step: f64) {
+    /// Before a step with the pose of `cmd` (the last step, with the pose of `stepped`,
+    /// took `step` s): wait for the next pose where the step would show at the same
+    /// display frame either way ([`wait_for_next_pose`]); the step then takes the newer
+    /// one.
+    fn align_with_next_pose(
+        &mut self,
+        cmd: &BodyCommand,
+        stepped: Option<CommandStamp>,
+        step: f64,
+    ) {
         let (frame, time) = cmd.stamp;
-        if let Some((f0, t0)) = self.seen.filter(|&(f0, _)| frame > f0) {
+        if let Some((f0, t0)) = stepped.filter(|&(f0, _)| frame > f0) {
             self.period = Some((time - t0) / (frame - f0) as f64);
         }
-        self.seen = Some((frame, time));
         let age = self.link.commands.age().map_or(0.0, |a| a.as_secs_f64());
         let Some(period) = self.period else {
             return;

@@ -145,17 +145,14 @@ impl FrameLog {
     /// 31's bound on the median (met where this is at least a half). Unlike the median,
     /// which jumps a whole period at a time, it moves with every frame.
     pub fn latency_share_within(&self, slack_ms: f64) -> Option<f64> {
-        let shown: Vec<&FrameRow> = self
+        let shown: Vec<(f64, f64)> = self
             .rows
             .iter()
-            .filter(|r| r.tool_latency_ms.is_some())
+            .filter_map(|r| r.tool_latency_ms.map(|l| (l, r.display_period * 1e3)))
             .collect();
         let within = shown
             .iter()
-            .filter(|r| {
-                r.tool_latency_ms
-                    .is_some_and(|l| l <= r.display_period * 1e3 + slack_ms + 1e-6)
-            })
+            .filter(|&&(l, period)| l <= period + slack_ms + 1e-6)
             .count();
         (!shown.is_empty()).then(|| within as f64 / shown.len() as f64)
     }
