@@ -217,6 +217,52 @@ fn newton_gives_the_same_bits_on_any_thread_count() {
     }
 }
 
+/// `Solver::prepare_frame` between frames (as the headset's simulation thread calls it
+/// after showing each frame) does the coarse refactorisation after a frame's releases
+/// before the next frame takes its pose — its time is the next frame's `ahead_ms` — and
+/// changes no bit of the run: the frame does the same work itself otherwise.
+#[test]
+fn preparing_a_frame_ahead_changes_no_bit() {
+    let run = |ahead: bool| {
+        let mut s = common::tearing_bar_with(|p| {
+            p.threads = 1;
+            p.scheme = Scheme::Newton(NewtonParams::default());
+        });
+        let mut frames = Vec::new();
+        for _ in 0..45 {
+            let st = s.step_frame().unwrap();
+            if ahead {
+                s.prepare_frame();
+            }
+            frames.push((s.positions().to_vec(), st.released_now, st.ahead_ms));
+        }
+        frames
+    };
+    let (plain, prepared) = (run(false), run(true));
+    assert!(
+        plain.iter().any(|f| f.1 > 0),
+        "the pull should release some tets"
+    );
+    for (f, (a, b)) in plain.iter().zip(&prepared).enumerate() {
+        let same =
+            a.0.iter()
+                .zip(&b.0)
+                .all(|(p, q)| p.to_array() == q.to_array());
+        assert!(
+            same && a.1 == b.1,
+            "frame {f}: preparing ahead moved the nodes"
+        );
+        assert_eq!(
+            a.2, 0.0,
+            "frame {f}: nothing is done ahead without the call"
+        );
+    }
+    // The frame after a release finds its refactorisation done (where no refresh,
+    // which refactorises anyway, is due).
+    let ahead = prepared.iter().filter(|f| f.2 > 0.0).count();
+    assert!(ahead > 0, "no frame had its refactorisation done ahead");
+}
+
 /// Each frame's stats report its Newton work: at least one iteration a frame and no more
 /// than the settings allow, a product per iteration at least, the iterations stopped at
 /// negative curvature among them, and line-search halvings once the bar has torn; under

@@ -47,6 +47,8 @@ pub struct CoarseLevel {
     max_nodes: usize,
     /// How many times the grid was rebuilt (what a copy of it, on the device, compares).
     generation: u32,
+    /// Tets left the matrix since it was last factorised ([`CoarseLevel::settle`]).
+    stale: bool,
 }
 
 /// How many more coarse nodes than the uncut body's a rebuilt grid may have: one half.
@@ -98,6 +100,7 @@ impl CoarseLevel {
             cut: false,
             max_nodes: grid.count + grid.count / SPLIT_GROWTH,
             generation: 0,
+            stale: false,
             grid,
         })
     }
@@ -157,6 +160,7 @@ impl CoarseLevel {
         let used = &self.used;
         let tangent = |t: usize| live[t].then(|| &used[t]);
         let refreshed = self.system.refresh(&mut self.assembly, tangent, team);
+        self.stale = false;
         rebuilt.and(refreshed)
     }
 
@@ -193,15 +197,27 @@ impl CoarseLevel {
     /// Take released tets (mesh indices) out of the matrix: their blocks at the tangents
     /// of the last refresh (the rest tangent before any) — only those it holds (a tet
     /// released by a check earlier in the frame may have been left out of a refresh since).
-    pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
-        self.cut |= !tets.is_empty();
+    /// The factor follows at [`CoarseLevel::settle`] (or the next refresh), so a frame's
+    /// releases cost no time before its state is shown.
+    pub fn release(&mut self, tets: &[u32]) {
         let in_coarse = &mut self.in_coarse;
         let held: Vec<u32> = tets
             .iter()
             .copied()
             .filter(|&t| std::mem::take(&mut in_coarse[t as usize]))
             .collect();
-        self.system
-            .release_refreshed(&self.assembly, &held, &self.used)
+        self.cut |= !tets.is_empty();
+        self.stale |= !held.is_empty();
+        self.system.subtract(&self.assembly, &held, &self.used);
+    }
+
+    /// Refactorise the matrix where tets left it since the last factorisation (the
+    /// previous factor stays where this fails: the coarse level only preconditions);
+    /// whether there was one to do.
+    pub fn settle(&mut self) -> Result<bool, CoarseError> {
+        if !std::mem::take(&mut self.stale) {
+            return Ok(false);
+        }
+        self.system.refactor().map(|()| true)
     }
 }

@@ -158,17 +158,11 @@ impl CoarseSystem {
     }
 
     /// Subtract released tets' blocks at the tangents `used` (per tet, those of the last
-    /// [`CoarseSystem::refresh`]) and refactorise on the same pattern.
-    pub fn release_refreshed(
-        &mut self,
-        assembly: &CoarseAssembly,
-        tets: &[u32],
-        used: &[TetTangent],
-    ) -> Result<(), CoarseError> {
+    /// [`CoarseSystem::refresh`]); the factor is the old one until [`CoarseSystem::refactor`].
+    pub fn subtract(&mut self, assembly: &CoarseAssembly, tets: &[u32], used: &[TetTangent]) {
         for &t in tets {
             assembly.add_tet(t as usize, &used[t as usize], -1.0, &mut self.blocks);
         }
-        self.refactor()
     }
 
     /// Lower-triangle coarse block `(row, col)` → its index (what [`CoarseAssembly`] reads).
@@ -203,7 +197,7 @@ impl CoarseSystem {
 
     /// Copy the blocks into the CSC values and factorise numerically (the previous factor
     /// stays when this fails).
-    fn refactor(&mut self) -> Result<(), CoarseError> {
+    pub fn refactor(&mut self) -> Result<(), CoarseError> {
         fill_block_values(&self.blocks, &self.position, &mut self.values);
         self.factor = factorise(&self.symbolic, &self.col_ptr, &self.row_idx, &self.values)?;
         Ok(())

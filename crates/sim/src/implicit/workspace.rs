@@ -110,9 +110,20 @@ impl NewtonWorkspace {
     }
 
     /// Take released tets (mesh indices) out of the coarse matrix
-    /// ([`CoarseLevel::release`]).
-    pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
-        self.pre.level.release(tets)
+    /// ([`CoarseLevel::release`]; refactorised by the next step or
+    /// [`NewtonWorkspace::settle_coarse`]).
+    pub fn release(&mut self, tets: &[u32]) {
+        self.pre.level.release(tets);
+    }
+
+    /// Refactorise the coarse matrix after releases now, unless the coming step
+    /// re-assembles it anyway (the step does it first otherwise, to the same bits): what
+    /// a caller does between showing a frame and taking the next one's tool pose
+    /// (`Solver::prepare_frame`). Whether there was one to do.
+    pub fn settle_coarse(&mut self) -> bool {
+        let level = &mut self.pre.level;
+        // The previous factor stays where this fails: the coarse level only preconditions.
+        !level.refresh_due(&self.last) && level.settle().unwrap_or(false)
     }
 
     /// Solve the next steps at step length `h` (a frame run again at more steps under
@@ -142,6 +153,10 @@ impl NewtonWorkspace {
         if self.pre.level.refresh_due(&self.last) {
             report.coarse_refreshed = true;
             report.coarse_refresh_failed = self.refresh_coarse(live, team).is_err();
+        } else {
+            // After releases (a refresh refactorises anyway); the previous factor stays
+            // where this fails.
+            let _ = self.pre.level.settle();
         }
         self.pre.level.tick();
         if let Some(m) = &mut self.pre.matrix {
@@ -630,7 +645,8 @@ mod tests {
             ws.hessian.evaluate(&u, &u, &live, &free, None);
             ws.refresh_coarse(&live, None).unwrap();
         }
-        released.release(&[5]).unwrap();
+        released.release(&[5]);
+        released.pre.level.settle().unwrap();
         for ws in [&fresh, &released] {
             let mut x = rhs.clone();
             ws.pre.level.system.solve(&mut x);
@@ -659,7 +675,8 @@ mod tests {
         live[40] = false;
         refreshed.hessian.evaluate(&rest, &rest, &live, &free, None);
         refreshed.refresh_coarse(&live, None).unwrap();
-        released.release(&[5, 40]).unwrap();
+        released.release(&[5, 40]);
+        released.pre.level.settle().unwrap();
         let rhs: Vec<f64> = (0..released.pre.rhs.len())
             .map(|i| (i as f64 * 0.37).sin())
             .collect();

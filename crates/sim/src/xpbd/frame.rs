@@ -38,6 +38,11 @@ pub struct FrameStats {
     pub check_ms: f64,
     /// Wall time of stress, guards and release, ms.
     pub stress_ms: f64,
+    /// Wall time of the frame's work done before it took the tool's pose
+    /// (`Solver::prepare_frame`, as the headset calls it after showing the last frame:
+    /// the implicit scheme's coarse refactorisation after the last frame's releases), ms;
+    /// 0 where there was none or the frame did it itself.
+    pub ahead_ms: f64,
     /// Parallel passes of the frame: on the CPU the colour and stress passes (each ends
     /// in a synchronisation of the threads), on the GPU the compute dispatches.
     pub passes: u32,

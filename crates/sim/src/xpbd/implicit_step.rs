@@ -11,6 +11,7 @@ use super::release_schedule::release_checks;
 use super::solver::{NodeKind, Solver};
 use super::{CpuKernel, SolverError};
 use glam::Vec3;
+use std::time::Instant;
 
 use crate::implicit::{NewtonParams, NewtonWorkspace, Scheme};
 use crate::thread_team::{for_each_item, part_count, share};
@@ -205,6 +206,22 @@ impl Solver {
         self.project_contacts(s, n);
         self.update_velocities(h);
         held
+    }
+
+    /// Do now what the coming frame can do before it knows the tool's pose: under
+    /// `scheme: Newton`, the coarse matrix's refactorisation after the last frame's
+    /// releases ([`NewtonWorkspace::settle_coarse`]); the frame does it itself when this
+    /// was not called, to the same bits. A caller that reads the tool's pose just before
+    /// each frame (the headset's simulation thread) calls this after showing the last
+    /// one, so the frame's step starts sooner after its pose. Its time is the next
+    /// frame's `ahead_ms`.
+    pub fn prepare_frame(&mut self) {
+        let started = Instant::now();
+        if let Some(ws) = &mut self.newton
+            && ws.settle_coarse()
+        {
+            self.ahead_ms += started.elapsed().as_secs_f64() * 1e3;
+        }
     }
 
     /// Live tets whose volume ratio `J` is at most 0 where the nodes stand now, leaving

@@ -113,6 +113,8 @@ pub struct Solver {
     /// The implicit scheme's buffers and preconditioner, built at its first step (when
     /// the pins and grabs are known).
     pub(crate) newton: Option<NewtonWorkspace>,
+    /// Wall time of the coming frame's work done ahead of it (`Solver::prepare_frame`), ms.
+    pub(crate) ahead_ms: f64,
 }
 
 /// The team for `threads` solver threads (0: one per core; 1: none, every pass on the
@@ -232,6 +234,7 @@ impl Solver {
             coarse_nodes: 0,
             team,
             newton: None,
+            ahead_ms: 0.0,
             lame,
             params,
             mesh,
@@ -498,8 +501,7 @@ impl Solver {
             self.set_live(t, false);
         }
         if let Some(ws) = &mut self.newton {
-            // The coarse level only preconditions: a failed refresh keeps the old one.
-            let _ = ws.release(&ev.tets);
+            ws.release(&ev.tets);
         }
         for &n in &ev.retired_nodes {
             self.kind[n as usize] = NodeKind::Retired;
@@ -554,6 +556,7 @@ impl Solver {
         stats.solve_ms = (t1 - t0).as_secs_f64() * 1e3;
         stats.check_ms = self.check_ms;
         stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
+        stats.ahead_ms = std::mem::take(&mut self.ahead_ms);
         self.frame += 1;
         Ok(stats)
     }
@@ -934,6 +937,7 @@ impl Solver {
             solve_ms: 0.0,
             check_ms: 0.0,
             stress_ms: 0.0,
+            ahead_ms: 0.0,
             passes: self.passes,
             cg_products: self.implicit_cost.cg_products,
             newton_iterations: self.implicit_cost.iterations,

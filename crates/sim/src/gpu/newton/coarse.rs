@@ -123,8 +123,10 @@ impl HostCoarse {
     }
 
     /// Take released tets (mesh indices) out of the coarse matrix, as
-    /// `NewtonWorkspace::release` does ([`CoarseLevel::release`]).
+    /// `NewtonWorkspace::release` does ([`CoarseLevel::release`]), and refactorise at
+    /// once: the device's inverse is recomputed from the factor with the release.
     pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
-        self.level.release(tets)
+        self.level.release(tets);
+        self.level.settle().map(drop)
     }
 }
