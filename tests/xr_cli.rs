@@ -269,6 +269,47 @@ fn the_default_organ_in_the_headset_pushes_back_on_the_scalpel() {
         pulses > 0 && r["max_haptic"].as_f64().unwrap() > 0.0,
         "the controller vibrated: {r}"
     );
+    // Stepped in the frame, the body refactorises its coarse level after a frame's
+    // releases once the display frame is handed over, before the next pose.
+    assert_prepared_ahead(&out);
+}
+
+/// The frames of `out/report.json` after releases had their pose-free work done ahead
+/// (`ahead_ms`, the implicit scheme's coarse refactorisation, `Solver::prepare_frame`).
+fn assert_prepared_ahead(out: &Path) {
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    let frames = report["frames"].as_array().unwrap();
+    let count = |key: &str| frames.iter().filter(|f| num(f, key) > 0.0).count();
+    let (released, ahead) = (count("released_now"), count("ahead_ms"));
+    assert!(
+        released > 1,
+        "the blade should cut: {released} frames released tets"
+    );
+    assert!(
+        ahead > 0,
+        "no frame had its refactorisation done ahead ({released} frames released tets)"
+    );
+}
+
+/// On its thread the simulation does the next frame's pose-free work right after it
+/// publishes a frame, before it takes the next pose: on the shipped plate_cut (the
+/// implicit scheme) a frame after releases finds its coarse refactorisation done.
+#[test]
+fn the_thread_refactorises_after_releases_before_the_next_pose() {
+    let script = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT))
+        .unwrap()
+        .replace("screenshots: [0]", "screenshots: []")
+        .replace("pacing: Nominal,", "")
+        .replace(
+            "render_every: 1000,",
+            "render_every: 1, eye_size: (64, 64), realtime: true,",
+        );
+    let args = ["config/plate_cut.ron", "--sim", "thread", "--device", "cpu"];
+    let (o, out) = run_xr("xr-rt-ahead", &script, &args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(xr_report(&out, &o)["sim_mode"], "thread");
+    assert_prepared_ahead(&out);
 }
 
 #[test]

@@ -329,6 +329,10 @@ impl WindowContent for Live {
             panel_frame,
             capture,
         )?;
+        if self.panel.playing {
+            // The next frame's pose-free work now, before it reads the mouse.
+            self.body.body.prepare_next_frame();
+        }
         let Some(image) = drawn else {
             return Ok(true);
         };

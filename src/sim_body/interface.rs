@@ -124,6 +124,13 @@ pub trait SimBody: Send {
     /// error the body stays at its last completed frame (guarded and rolled back).
     fn step(&mut self, tool: &ToolInput) -> Result<FrameData, StepError>;
 
+    /// Do now the part of the next frame that does not depend on the tool's pose (the
+    /// implicit scheme's coarse refactorisation after releases, `Solver::prepare_frame`):
+    /// a caller that reads the pose just before each frame calls this after showing the
+    /// last one, so the frame's step starts sooner after its pose. The next frame does it
+    /// itself otherwise, to the same bits.
+    fn prepare_next_frame(&mut self) {}
+
     /// Where the tool is at the end of the last frame (`None`: no tool).
     fn tool_pose(&self) -> Option<ToolPose>;
 

@@ -299,6 +299,10 @@ impl SimBody for XpbdBody {
         }
     }
 
+    fn prepare_next_frame(&mut self) {
+        self.body.prepare_frame();
+    }
+
     fn tool_pose(&self) -> Option<ToolPose> {
         self.pose
     }

@@ -162,6 +162,15 @@ impl Body {
         }
     }
 
+    /// Do the next frame's work that does not depend on the tool's pose now
+    /// (`Solver::prepare_frame`; on the GPU the coarse level is refactorised with each
+    /// release, as its inverse is uploaded then).
+    pub fn prepare_frame(&mut self) {
+        if let Body::Cpu(s) = self {
+            s.prepare_frame();
+        }
+    }
+
     /// Attach `tool` at `pose`, replacing any tool (see `Solver::set_tool`).
     pub fn set_tool(
         &mut self,

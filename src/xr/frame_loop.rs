@@ -183,6 +183,7 @@ impl Display<'_, '_> {
                 .map(|(_, t)| (frame.display_time - t) * 1e3),
         };
         self.log(frame, &adv, &cmd, shown, [started, render_start]);
+        sim.after_frame();
         ended
     }
 

@@ -45,6 +45,12 @@ pub trait HeadsetSim {
     /// Step (or hand the thread) this display frame's tool command.
     fn advance(&mut self, frame: &HeadsetFrame, cmd: &ToolCommand) -> Result<Advanced>;
 
+    /// After the display frame went to the runtime: the body stepped in the frame does the
+    /// next frame's work that needs no pose now, off the time between the next pose and
+    /// its display ([`crate::sim_body::SimBody::prepare_next_frame`]; the thread does the
+    /// same after each frame it publishes).
+    fn after_frame(&mut self) {}
+
     /// Whether the controller vibrates with the tool force this frame.
     fn vibrates(&self, cmd: &ToolCommand) -> bool {
         cmd.engaged

@@ -163,6 +163,12 @@ impl LiveSim {
         (self.played.as_ref()).is_some_and(|s| self.body.body.time() >= s.end_time() - 1e-9)
     }
 
+    /// Do the next frame's work that does not depend on the tool's pose now
+    /// ([`crate::sim_body::SimBody::prepare_next_frame`]).
+    pub fn prepare_next(&mut self) {
+        self.body.body.prepare_next_frame();
+    }
+
     /// Step one frame with `cmd` (a played stroke: the body's own script). Errors other
     /// than a failed body frame end the session.
     pub fn step(&mut self, cmd: &BodyCommand) -> Result<Stepped> {

@@ -412,6 +412,10 @@ impl HeadsetSim for Session {
         Ok(())
     }
 
+    fn after_frame(&mut self) {
+        self.stepper.after_frame();
+    }
+
     /// Step the body (or hand its thread the command) with the frame's tool.
     fn advance(&mut self, frame: &HeadsetFrame, cmd: &ToolCommand) -> Result<Advanced> {
         let tool = self.tool(cmd);

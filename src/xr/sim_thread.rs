@@ -320,7 +320,11 @@ impl Loop<'_> {
         for _ in 0..frames {
             let cmd = self.command();
             match live.step(&cmd)? {
-                Stepped::Done => self.publish(live),
+                Stepped::Done => {
+                    self.publish(live);
+                    // The next frame's pose-free work now, before it takes its pose.
+                    live.prepare_next();
+                }
                 Stepped::Failed(e) => {
                     // Rolled back: start the scene again rather than end the session.
                     eprintln!("xr: {e}; resetting the scene");

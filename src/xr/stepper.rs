@@ -122,6 +122,14 @@ impl Stepper {
         }
     }
 
+    /// After the display frame: the body stepped in the frame does the next frame's
+    /// pose-free work ([`LiveSim::prepare_next`]); the thread does its own.
+    pub fn after_frame(&mut self) {
+        if let Stepper::InFrame { live, .. } = self {
+            live.prepare_next();
+        }
+    }
+
     /// A pressed: the body stepped in the frame starts over now (its fresh frame
     /// returned); the thread is told with the next command (`None`).
     pub fn reset(&mut self, hook: &mut dyn FrameHook) -> Result<Option<BodyView>> {
