@@ -52,7 +52,7 @@ pub struct Attempt {
 }
 
 /// Score `opts.stroke` on `opts.exercise`: the stroke replayed by `incise run`'s
-/// machinery for its duration plus [`SETTLE_TIME`], then [`score_attempt`] and
+/// machinery for its duration plus `SETTLE_TIME` (0.2 s), then [`score_attempt`] and
 /// [`save_attempt`] into `opts.out`.
 pub fn run_exercise(opts: &ExerciseOptions) -> Result<Attempt> {
     let ex = load_exercise(&opts.exercise)?;

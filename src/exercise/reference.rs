@@ -75,7 +75,7 @@ const FINISH_TILT_DEG: f64 = 75.0;
 /// the blade's lowest edge point at the target depth below the plan (rest coordinates),
 /// aimed along it, handle leading and raised `tilt_deg` where it enters (the edge in the
 /// tissue starting at the plan's start). The handle then rises steadily to
-/// [`FINISH_TILT_DEG`], so that the lowest point reaches the plan's end (less half the
+/// `FINISH_TILT_DEG` (75°), so that the lowest point reaches the plan's end (less half the
 /// lateral tolerance, the reach of the cutting spheres) with little edge ahead of it in
 /// the tissue ("finishing on the tip"), and the blade lifts out along the surface normal.
 pub fn reference_stroke(ex: &LoadedExercise, style: ReferenceStyle) -> Result<Stroke> {

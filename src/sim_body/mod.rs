@@ -1,6 +1,6 @@
 //! The simulated body of each method behind one interface ([`SimBody`]): the XPBD solver
 //! on its device, the Nakao mass-spring cutter (frame by frame or at a haptic rate) and
-//! the three-element rheological body, side by side; [`open`] opens a scene's.
+//! the three-element rheological body, side by side; [`open()`] opens a scene's.
 
 pub mod body_view;
 pub mod edge_report;

@@ -182,7 +182,7 @@ fn split_parts<T>(mut items: &mut [T], unit: usize, parts: usize) -> Vec<&mut [T
 const PARTS_PER_MEMBER: usize = 4;
 
 /// Parts to cut a pass over `len` items into: one without a team, else one per
-/// `min_part` items, at most [`PARTS_PER_MEMBER`] per member.
+/// `min_part` items, at most `PARTS_PER_MEMBER` per member.
 pub fn part_count(team: Option<&ThreadTeam>, len: usize, min_part: usize) -> usize {
     match team {
         Some(t) => (len / min_part.max(1)).clamp(1, PARTS_PER_MEMBER * t.size()),

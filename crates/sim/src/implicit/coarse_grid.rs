@@ -45,7 +45,7 @@ pub struct CoarseGrid {
 impl CoarseGrid {
     /// The grid of cubes of edge `cell` over `points`, one coarse node per piece of the
     /// body a corner covers (its free nodes connected through the `tets` marked `live`,
-    /// [`pieces`]); nodes with `free[i] == false` get no weights (their values are fixed,
+    /// `pieces`); nodes with `free[i] == false` get no weights (their values are fixed,
     /// not solved for).
     pub fn new(
         points: &[Vec3],

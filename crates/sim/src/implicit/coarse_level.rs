@@ -140,7 +140,7 @@ impl CoarseLevel {
     /// and refactorise, the tangents and the sums shared by the members of `team`; on an
     /// error (not positive definite) the previous factor stays, while the blocks are these
     /// tangents'. First the rebuild started at the last refresh is taken, and where tets
-    /// were released since, the next one starts ([`super::coarse_rebuild`]).
+    /// were released since, the next one starts (`coarse_rebuild.rs`).
     pub fn refresh(
         &mut self,
         tangent: impl Fn(usize) -> TetTangent + Sync,

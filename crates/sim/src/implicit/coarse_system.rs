@@ -76,7 +76,7 @@ impl CoarseSystem {
 
     /// `Pᵀ (M/h²) P` on the pattern of `tets`' corner pairs (shape gradients `b`, lumped
     /// `mass`), factorised, with the assembly a refresh fills it by: the tets are grouped
-    /// by corner set once, for both ([`Grouping`]).
+    /// by corner set once, for both (`Grouping`).
     pub fn with_assembly(
         grid: &CoarseGrid,
         (tets, b): (&[RestTet], &[[Vec3; 4]]),
@@ -165,7 +165,7 @@ impl CoarseSystem {
         }
     }
 
-    /// Lower-triangle coarse block `(row, col)` → its index (what [`CoarseAssembly`] reads).
+    /// Lower-triangle coarse block `(row, col)` → its index (what `CoarseAssembly` reads).
     pub fn block_index(&self) -> &HashMap<(u32, u32), usize> {
         &self.index
     }

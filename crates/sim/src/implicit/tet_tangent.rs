@@ -64,7 +64,7 @@ impl TetTangent {
     }
 
     /// This tangent with its indefinite parts cut, `c ≥ 0` and `s₃ ≥ −μ/σ̂` (σ̂ ≥ 1 a
-    /// Gershgorin bound of the largest stretch, [`largest_stretch_bound`]; at rest nothing
+    /// Gershgorin bound of the largest stretch, `largest_stretch_bound`; at rest nothing
     /// is cut): positive semi-definite, what the preconditioner's matrices hold.
     #[inline]
     pub fn definite(&self) -> Self {

@@ -182,7 +182,7 @@ impl GodObject {
     }
 
     /// Move the device to `device` and update the proxy on `surface` at node positions `x`;
-    /// returns the proxy's contact. Call [`GodObject::reset`] after the surface is rebuilt.
+    /// returns the proxy's contact. Call [`GodObject::rebind`] after the surface is rebuilt.
     pub fn update(
         &mut self,
         device: DVec3,

@@ -100,7 +100,7 @@ impl Strain {
     }
 }
 
-/// `x − ln(1 + x)` for `x > −1`, accurate near 0 (series below [`SERIES_LIMIT`]); the
+/// `x − ln(1 + x)` for `x > −1`, accurate near 0 (series below `SERIES_LIMIT`); the
 /// same operations as `log1p_excess` in `gpu/shaders/neo_hookean.wgsl`.
 #[inline]
 pub fn log1p_excess(x: f32) -> f32 {

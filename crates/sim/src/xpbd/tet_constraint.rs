@@ -11,7 +11,7 @@ use super::rest_free::project_rest_free;
 
 /// Project both constraints of `pair` of one tet in place (`x` holds the nodes'
 /// displacements from rest, see
-/// [`super::neo_hookean::deformation_gradient_from_displacement`]); returns the
+/// `deformation_gradient_from_displacement`); returns the
 /// volume multiplier of this substep (the seed's hydrostatic stress, PHYSICS.md §1.3).
 #[inline]
 pub fn project_tet(
