@@ -297,16 +297,8 @@ fn assert_prepared_ahead(out: &Path) {
 /// implicit scheme) a frame after releases finds its coarse refactorisation done.
 #[test]
 fn the_thread_refactorises_after_releases_before_the_next_pose() {
-    let script = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT))
-        .unwrap()
-        .replace("screenshots: [0]", "screenshots: []")
-        .replace("pacing: Nominal,", "")
-        .replace(
-            "render_every: 1000,",
-            "render_every: 1, eye_size: (64, 64), realtime: true,",
-        );
     let args = ["config/plate_cut.ron", "--sim", "thread", "--device", "cpu"];
-    let (o, out) = run_xr("xr-rt-ahead", &script, &args);
+    let (o, out) = run_xr("xr-rt-ahead", &realtime_script(), &args);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert_eq!(xr_report(&out, &o)["sim_mode"], "thread");
     assert_prepared_ahead(&out);
@@ -697,16 +689,21 @@ fn eyes_left_undrawn_still_show_every_frame_and_its_latency() {
 
 /// The plate-cut script on the wall clock (a frame that comes late skips the refreshes
 /// it missed, as on a runtime), 64 px eyes drawn every frame, substeps paced as on a
-/// headset; `incise xr` on it with `args`.
-fn run_realtime(name: &str, args: &[&str]) -> (std::process::Output, std::path::PathBuf) {
-    let script = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT))
+/// headset.
+fn realtime_script() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(SCRIPT))
         .unwrap()
         .replace("screenshots: [0]", "screenshots: []")
         .replace("pacing: Nominal,", "")
         .replace(
             "render_every: 1000,",
             "render_every: 1, eye_size: (64, 64), realtime: true,",
-        );
+        )
+}
+
+/// `incise xr` on [`realtime_script`] with `args`.
+fn run_realtime(name: &str, args: &[&str]) -> (std::process::Output, std::path::PathBuf) {
+    let script = realtime_script();
     // plate_cut on XPBD: these runs time the session's threads against a slowed solver,
     // and were set on XPBD's frame (on the implicit scheme, which the shipped scene runs,
     // the in-frame run's last frames outlast the script's end: 144 refreshes shown).
