@@ -163,11 +163,11 @@ impl Body {
     }
 
     /// Do the next frame's work that does not depend on the tool's pose now
-    /// (`Solver::prepare_frame`; on the GPU the coarse level is refactorised with each
-    /// release, as its inverse is uploaded then).
+    /// (`Solver::prepare_frame`, `GpuSolver::prepare_frame`).
     pub fn prepare_frame(&mut self) {
-        if let Body::Cpu(s) = self {
-            s.prepare_frame();
+        match self {
+            Body::Cpu(s) => s.prepare_frame(),
+            Body::Gpu(g) => g.prepare_frame(),
         }
     }
 

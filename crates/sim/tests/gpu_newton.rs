@@ -221,6 +221,50 @@ fn a_tearing_bar_matches_the_cpu() {
     );
 }
 
+/// `GpuSolver::prepare_frame` between frames (as the headset's simulation thread calls
+/// it) refactorises the coarse level and uploads its inverse after a frame's releases
+/// before the next frame takes its pose — its time is that frame's `ahead_ms` — and
+/// changes no bit of the run, as on the CPU.
+#[test]
+fn preparing_a_frame_ahead_on_the_device_changes_no_bit() {
+    let Some(ctx) = common::gpu_context() else {
+        return;
+    };
+    let bar = || {
+        let solver = common::tearing_bar_with(|p| {
+            p.threads = 1;
+            // Refreshed every other frame: the frames between find the releases'
+            // refactorisation to do.
+            p.scheme = Scheme::Newton(NewtonParams {
+                steps: 4,
+                coarse_refresh: CoarseRefresh::Steps(8),
+                ..CONVERGED
+            });
+        });
+        GpuSolver::new(solver, &ctx).expect("upload")
+    };
+    let (mut plain, mut prepared) = (bar(), bar());
+    let mut ahead = 0;
+    for frame in 0..16 {
+        let a = plain.step_frame().unwrap();
+        let b = prepared.step_frame().unwrap();
+        prepared.prepare_frame();
+        let (x, y) = (plain.host().positions(), prepared.host().positions());
+        let same = x.iter().zip(y).all(|(p, q)| p.to_array() == q.to_array());
+        assert!(
+            same && a.released_total == b.released_total,
+            "frame {frame}: preparing ahead moved the nodes"
+        );
+        assert_eq!(
+            a.ahead_ms, 0.0,
+            "frame {frame}: nothing ahead without the call"
+        );
+        ahead += u32::from(b.ahead_ms > 0.0);
+    }
+    assert!(plain.host().cut().released_count() > 0, "the bar tears");
+    assert!(ahead > 0, "no frame had its coarse inverse done ahead");
+}
+
 /// A blade pressed into a pinned block, two implicit steps a frame: the tool's contact
 /// (its nodes held through each step's solve, a pose per step) gives the same dent within
 /// [`WHOLE`], the same force (the held nodes' reactions) within 1 % and the same Newton

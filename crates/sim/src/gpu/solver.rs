@@ -674,7 +674,7 @@ impl GpuSolver {
         let ev = self.host.release(&mesh_tets);
         self.retire_on_device(&ev.retired_nodes);
         if let Some(newton) = &mut self.newton {
-            newton.release(&self.queue, &ev.tets);
+            newton.release(&ev.tets);
         }
         if let Some(m) = &mut self.host.tool {
             m.from = m.to;
@@ -682,8 +682,22 @@ impl GpuSolver {
         let mut stats = self.host.stats(ev.tets.len());
         stats.solve_ms = solve_ms;
         stats.stress_ms = t1.elapsed().as_secs_f64() * 1e3;
+        stats.ahead_ms = std::mem::take(&mut self.host.ahead_ms);
         self.host.frame += 1;
         Ok(stats)
+    }
+
+    /// Do now what the coming frame can do before it knows the tool's pose
+    /// (`Solver::prepare_frame`'s twin): under `scheme: Newton`, the coarse level's
+    /// refactorisation and inverse upload after the last frame's releases. Its time is the
+    /// next frame's `ahead_ms`.
+    pub fn prepare_frame(&mut self) {
+        let started = Instant::now();
+        if let Some(newton) = &mut self.newton
+            && newton.settle_coarse(&self.queue)
+        {
+            self.host.ahead_ms += started.elapsed().as_secs_f64() * 1e3;
+        }
     }
 
     /// One attempt at the frame in `n` steps: upload, record, submit and read back into

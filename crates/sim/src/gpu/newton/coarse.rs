@@ -123,10 +123,16 @@ impl HostCoarse {
     }
 
     /// Take released tets (mesh indices) out of the coarse matrix, as
-    /// `NewtonWorkspace::release` does ([`CoarseLevel::release`]), and refactorise at
-    /// once: the device's inverse is recomputed from the factor with the release.
-    pub fn release(&mut self, tets: &[u32]) -> Result<(), CoarseError> {
+    /// `NewtonWorkspace::release` does ([`CoarseLevel::release`]); refactorised by
+    /// [`HostCoarse::settle`].
+    pub fn release(&mut self, tets: &[u32]) {
         self.level.release(tets);
-        self.level.settle().map(drop)
+    }
+
+    /// Refactorise after releases unless the coming step refreshes anyway (`last`: the
+    /// last step's report), as `NewtonWorkspace::settle_coarse` does; whether the factor
+    /// changed (a failed refactorisation keeps the old one: the level only preconditions).
+    pub fn settle(&mut self, last: &NewtonReport) -> bool {
+        !self.level.refresh_due(last) && self.level.settle().unwrap_or(false)
     }
 }

@@ -127,6 +127,8 @@ impl GpuNewton {
             report.coarse_refreshed = true;
             report.coarse_refresh_failed = self.coarse.refresh(&u, live, team).is_err();
             self.upload_coarse(dev.queue);
+        } else {
+            self.settle_coarse(dev.queue);
         }
         self.coarse.tick();
         let mut enc = encoder(dev);
