@@ -14,7 +14,7 @@ use crate::thread_team::ThreadTeam;
 use crate::vbd::shape_gradients;
 
 /// Most coarse nodes the device takes: its `A_c⁻¹` is dense (9 n² values, 38 MB at this
-/// bound) and recomputed on the host at every refresh and release.
+/// bound) and recomputed on the host at every refresh and after releases.
 pub const MAX_COARSE_NODES: usize = 1024;
 
 /// The coarse level as the host keeps it for the device.
