@@ -220,4 +220,12 @@ impl CoarseLevel {
         }
         self.system.refactor().map(|()| true)
     }
+
+    /// [`CoarseLevel::settle`] unless the coming step re-assembles the matrix anyway
+    /// (`last`: the previous step's report), as a caller does ahead of the frame; whether
+    /// the factor changed (a failed refactorisation keeps the old one: the level only
+    /// preconditions).
+    pub fn settle_ahead(&mut self, last: &NewtonReport) -> bool {
+        !self.refresh_due(last) && self.settle().unwrap_or(false)
+    }
 }

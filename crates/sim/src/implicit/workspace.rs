@@ -121,9 +121,7 @@ impl NewtonWorkspace {
     /// a caller does between showing a frame and taking the next one's tool pose
     /// (`Solver::prepare_frame`). Whether there was one to do.
     pub fn settle_coarse(&mut self) -> bool {
-        let level = &mut self.pre.level;
-        // The previous factor stays where this fails: the coarse level only preconditions.
-        !level.refresh_due(&self.last) && level.settle().unwrap_or(false)
+        self.pre.level.settle_ahead(&self.last)
     }
 
     /// Solve the next steps at step length `h` (a frame run again at more steps under

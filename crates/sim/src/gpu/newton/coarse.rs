@@ -129,10 +129,10 @@ impl HostCoarse {
         self.level.release(tets);
     }
 
-    /// Refactorise after releases unless the coming step refreshes anyway (`last`: the
-    /// last step's report), as `NewtonWorkspace::settle_coarse` does; whether the factor
-    /// changed (a failed refactorisation keeps the old one: the level only preconditions).
+    /// Refactorise after releases unless the coming step refreshes anyway
+    /// ([`CoarseLevel::settle_ahead`], as `NewtonWorkspace::settle_coarse` does); whether
+    /// the factor changed.
     pub fn settle(&mut self, last: &NewtonReport) -> bool {
-        !self.level.refresh_due(last) && self.level.settle().unwrap_or(false)
+        self.level.settle_ahead(last)
     }
 }
