@@ -50,6 +50,8 @@ pub trait Lane:
     fn max(self, o: Self) -> Self;
     /// Natural logarithm per lane (finite `x > 0`).
     fn ln(self) -> Self;
+    /// With `self` a mask: the lanes set, one bit each (lane `k` is bit `k`).
+    fn bits(self) -> u32;
 }
 
 impl Lane for f32x8 {
@@ -102,5 +104,9 @@ impl Lane for f32x8 {
     #[inline(always)]
     fn ln(self) -> Self {
         f32x8::ln(self)
+    }
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        f32x8::to_bitmask(self)
     }
 }

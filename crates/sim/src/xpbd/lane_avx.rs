@@ -90,6 +90,11 @@ impl Lane for Avx {
     fn max(self, o: Self) -> Self {
         avx!(_mm256_max_ps(self.0, o.0))
     }
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        // SAFETY: as `avx!`.
+        unsafe { _mm256_movemask_ps(self.0) as u32 }
+    }
     /// The Cephes `logf` polynomial, as `wide` evaluates it: `x = m 2^e`, `m` in
     /// [√½, √2), `ln x = e ln 2 + ln m` (ln 2 split in two), `ln(1 + f)` of degree 9.
     #[inline(always)]

@@ -30,13 +30,52 @@ pub struct TetLanes<L> {
 /// `log1p_excess`).
 #[inline(always)]
 pub(crate) fn log1p_excess<L: Lane>(x: L) -> L {
+    let series = x.abs().simd_lt(L::splat(SERIES_LIMIT));
+    match Taken::of(series) {
+        Taken::All => log1p_excess_series(x),
+        Taken::None => log1p_excess_direct(x),
+        Taken::Some => series.select(log1p_excess_series(x), log1p_excess_direct(x)),
+    }
+}
+
+/// `x − ln(1 + x)` by its series.
+#[inline(always)]
+fn log1p_excess_series<L: Lane>(x: L) -> L {
     let s = L::splat;
     let x2 = x * x;
     let tail = s(-1.0 / 7.0) + x * s(0.125);
     let tail = s(-0.2) + x * (s(1.0 / 6.0) + x * tail);
-    let series = x2 * (s(0.5) + x * (s(-1.0 / 3.0) + x * (s(0.25) + x * tail)));
-    let direct = x - (L::ONE + x).ln();
-    x.abs().simd_lt(s(SERIES_LIMIT)).select(series, direct)
+    x2 * (s(0.5) + x * (s(-1.0 / 3.0) + x * (s(0.25) + x * tail)))
+}
+
+/// `x − ln(1 + x)` directly.
+#[inline(always)]
+fn log1p_excess_direct<L: Lane>(x: L) -> L {
+    x - (L::ONE + x).ln()
+}
+
+/// Which lanes a mask sets: a branch of the reference that no lane takes is not evaluated
+/// (each lane's value is the same either way: `select` only picks).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Taken {
+    /// Every lane.
+    All,
+    /// No lane.
+    None,
+    /// Some lanes.
+    Some,
+}
+
+impl Taken {
+    /// The lanes `mask` sets.
+    #[inline(always)]
+    pub(crate) fn of<L: Lane>(mask: L) -> Taken {
+        match mask.bits() {
+            0 => Taken::None,
+            b if b == (1 << super::lane::LANES) - 1 => Taken::All,
+            _ => Taken::Some,
+        }
+    }
 }
 
 /// The invariants of `F = I + H` from `H` (strain.rs `Strain`).
@@ -94,11 +133,16 @@ impl<L: Lane> StrainLanes<L> {
 pub(crate) fn log_volume<L: Lane>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
     let j = L::ONE + s.j1;
     let above = j.simd_gt(L::splat(J_MIN));
-    let l = above.select(
-        s.j1 - excess,
-        L::splat(J_MIN.ln()) + (j - L::splat(J_MIN)) / L::splat(J_MIN),
-    );
-    let dl = above.select(L::ONE / j, L::splat(1.0 / J_MIN));
+    let l_above = || s.j1 - excess;
+    let l_below = || L::splat(J_MIN.ln()) + (j - L::splat(J_MIN)) / L::splat(J_MIN);
+    let (l, dl) = match Taken::of(above) {
+        Taken::All => (l_above(), L::ONE / j),
+        Taken::None => (l_below(), L::splat(1.0 / J_MIN)),
+        Taken::Some => (
+            above.select(l_above(), l_below()),
+            above.select(L::ONE / j, L::splat(1.0 / J_MIN)),
+        ),
+    };
     (l, dl, above)
 }
 
@@ -116,12 +160,18 @@ pub(crate) fn shape_energy<L: Lane>(
     let two = L::splat(2.0);
     let h_norm2 = s.h.norm2();
     let j = L::ONE + s.j1;
-    let psi_above = h_norm2 - two * s.i2 - two * s.det_h + two * excess;
-    let psi_below = two * s.tr + h_norm2 - two * l;
-    let psi = above.select(psi_above, psi_below).max(L::ZERO);
-    let grad_above = s.j_f_minus_cof() * (L::ONE / j);
-    let grad_below = M3::diagonal(L::ONE) + s.h - *cof_f * dl;
-    (psi, select_m3(above, &grad_above, &grad_below))
+    let psi_above = || h_norm2 - two * s.i2 - two * s.det_h + two * excess;
+    let psi_below = || two * s.tr + h_norm2 - two * l;
+    let grad_above = || s.j_f_minus_cof() * (L::ONE / j);
+    let grad_below = || M3::diagonal(L::ONE) + s.h - *cof_f * dl;
+    match Taken::of(above) {
+        Taken::All => (psi_above().max(L::ZERO), grad_above()),
+        Taken::None => (psi_below().max(L::ZERO), grad_below()),
+        Taken::Some => (
+            above.select(psi_above(), psi_below()).max(L::ZERO),
+            select_m3(above, &grad_above(), &grad_below()),
+        ),
+    }
 }
 
 /// `C_D = sqrt(ψ̂)`, `∂C_D/∂F`, and the lanes where `C_D` has a direction
@@ -177,6 +227,9 @@ fn weighted_dot<L: Lane>(w: &[L; 4], a: &[V3<L>; 4], b: &[V3<L>; 4]) -> L {
 /// where its constraint does not apply.
 #[inline(always)]
 fn row<L: Lane>(on: L, g: [V3<L>; 4], c: L, alpha: L) -> ([V3<L>; 4], L, L) {
+    if Taken::of(on) == Taken::All {
+        return (g, c, alpha);
+    }
     (
         // Written out, not `map` (see lane_pass.rs).
         [
@@ -227,9 +280,15 @@ pub fn project_rest_free_lanes<L: Lane>(t: &mut TetLanes<L>) -> L {
     let (r1, r2) = (-c_h * sc, -c_d * sc);
     let dl_h = ok.select((r1 * d - b * r2) / det, L::ZERO);
     let dl_d = ok.select((a * r2 - b * r1) / det, L::ZERO);
+    let all_ok = Taken::of(ok) == Taken::All;
     for i in 0..4 {
         let dx = (g_h[i] * dl_h + g_d[i] * dl_d) * t.w[i];
-        t.u[i] = t.u[i] + select_v3(ok, dx, V3::ZERO);
+        t.u[i] = t.u[i]
+            + if all_ok {
+                dx
+            } else {
+                select_v3(ok, dx, V3::ZERO)
+            };
     }
     dl_h
 }
@@ -282,26 +341,40 @@ mod tests {
     /// Lane k projects what the scalar reference projects for tet k, in every branch
     /// (rest, small and large strain, J below J_MIN, inverted, no volume constraint),
     /// and a lane that is not live stays put: with the portable lanes, and with the AVX
-    /// ones where the CPU has AVX2.
+    /// ones where the CPU has AVX2. Once with the eight cases side by side (every mask
+    /// mixed: both sides of each branch evaluated and selected), then with each case in
+    /// all eight lanes (a branch no lane takes is skipped, `Taken`). Broken on purpose
+    /// once each: `row`'s every-lane arm given a unit compliance, `log_volume`'s arms
+    /// given the other side's `L'`: fails.
     #[test]
     fn lanes_match_the_scalar_reference() {
-        check::<wide::f32x8>();
+        let mixed = |k: usize| (k, k != 5);
+        check::<wide::f32x8>(mixed);
+        for case in 0..LANES {
+            check::<wide::f32x8>(|_| (case, true));
+        }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
-            check::<crate::xpbd::lane_avx::Avx>();
+            use crate::xpbd::lane_avx::Avx;
+            check::<Avx>(mixed);
+            for case in 0..LANES {
+                check::<Avx>(|_| (case, true));
+            }
         }
     }
 
-    fn check<L: Lane>() {
+    /// `lane(k)`: which of the [`displacements`] lane k holds and whether it is live.
+    fn check<L: Lane>(lane: impl Fn(usize) -> (usize, bool)) {
         for alpha_h in [0.2f32, f32::INFINITY] {
+            let case = |k: usize| lane(k).0;
             let w = |k: usize| [1.0, 0.5 + 0.1 * k as f32, 2.0, 0.0];
-            let u: [[Vec3; 4]; LANES] = std::array::from_fn(displacements);
-            let dm: [Mat3; LANES] = std::array::from_fn(|k| terms(k, alpha_h).dm_inv);
+            let u: [[Vec3; 4]; LANES] = std::array::from_fn(|k| displacements(case(k)));
+            let dm: [Mat3; LANES] = std::array::from_fn(|k| terms(case(k), alpha_h).dm_inv);
             let live: [f32; LANES] = std::array::from_fn(|k| {
-                if k == 5 {
-                    0.0
-                } else {
+                if lane(k).1 {
                     f32::from_bits(u32::MAX)
+                } else {
+                    0.0
                 }
             });
             let mut lanes = TetLanes {
@@ -309,16 +382,17 @@ mod tests {
                 w: std::array::from_fn(|j| L::new(std::array::from_fn(|k| w(k)[j]))),
                 dm_inv: M3::gather(&dm),
                 alpha_h: L::splat(alpha_h),
-                alpha_d: L::new(std::array::from_fn(|k| terms(k, alpha_h).alpha_d)),
+                alpha_d: L::new(std::array::from_fn(|k| terms(case(k), alpha_h).alpha_d)),
                 live: L::new(live),
             };
             let dl = project_rest_free_lanes(&mut lanes).to_array();
             for k in 0..LANES {
                 let mut x = u[k];
-                let want = if k == 5 {
-                    0.0
+                let terms = terms(case(k), alpha_h);
+                let want = if lane(k).1 {
+                    project_rest_free(&mut x, &w(k), &terms, TetProjection::Coupled)
                 } else {
-                    project_rest_free(&mut x, &w(k), &terms(k, alpha_h), TetProjection::Coupled)
+                    0.0
                 };
                 let tol = 2e-6 * (1.0 + want.abs());
                 assert!(
