@@ -16,7 +16,7 @@ use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
 
 use glam::{Mat3, Vec3};
 
-use super::lane::{LANES, Lane};
+use super::lane::{LANES, Lane, LaneMath};
 use super::lanes::{M3, V3};
 use super::rest_free_lanes::{TetLanes, project_rest_free_lanes};
 
@@ -92,16 +92,20 @@ impl BitAnd for Counted {
 }
 
 impl Lane for Counted {
-    const ZERO: Self = Counted([0.0; LANES]);
-    const ONE: Self = Counted([1.0; LANES]);
     fn new(v: [f32; LANES]) -> Self {
         Counted(v)
     }
-    fn splat(v: f32) -> Self {
-        Counted([v; LANES])
-    }
     fn to_array(self) -> [f32; LANES] {
         self.0
+    }
+}
+
+impl LaneMath for Counted {
+    const ZERO: Self = Counted([0.0; LANES]);
+    const ONE: Self = Counted([1.0; LANES]);
+    const ALL: u32 = (1 << LANES) - 1;
+    fn splat(v: f32) -> Self {
+        Counted([v; LANES])
     }
     fn simd_lt(self, o: Self) -> Self {
         self.zip(o, |a, b| Counted::mask(a < b))

@@ -1,9 +1,11 @@
-//! What one lane type of the batched tet projection provides: eight `f32` (one tet each)
+//! What a lane type of the batched tet projection provides: `f32` lanes (one tet each)
 //! with arithmetic, masks (all bits set or clear, as comparisons return) and the few
-//! functions the rest-free pair needs. Two types implement it: `wide::f32x8`, whose
+//! functions the rest-free pair needs ([`LaneMath`], whatever the width), and for eight
+//! lanes their loads and stores ([`Lane`]). Eight-lane types: `wide::f32x8`, whose
 //! instructions are fixed when the crate is compiled (two SSE registers in the portable
-//! build), and [`super::lane_avx::Avx`], one AVX register, used only inside the function
-//! compiled for AVX2 that [`super::lane_pass`] picks at run time.
+//! build), and [`super::lane_avx::Avx`], one AVX register, used only inside the functions
+//! compiled for AVX2 that [`super::lane_pass`] picks at run time; sixteen lanes:
+//! [`super::lane_avx512::Avx512`], one AVX-512 register, two blocks at once.
 
 use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
 
@@ -12,8 +14,8 @@ use wide::f32x8;
 /// Number of tets projected together.
 pub const LANES: usize = 8;
 
-/// Eight `f32` lanes.
-pub trait Lane:
+/// The arithmetic of `f32` lanes of any width.
+pub trait LaneMath:
     Copy
     + Add<Output = Self>
     + Sub<Output = Self>
@@ -26,12 +28,10 @@ pub trait Lane:
     const ZERO: Self;
     /// 1.0 in every lane.
     const ONE: Self;
-    /// Lane `k` is `v[k]`.
-    fn new(v: [f32; LANES]) -> Self;
+    /// [`LaneMath::bits`] of a mask with every lane set.
+    const ALL: u32;
     /// `v` in every lane.
     fn splat(v: f32) -> Self;
-    /// The lanes.
-    fn to_array(self) -> [f32; LANES];
     /// Mask of the lanes where `self < o`.
     fn simd_lt(self, o: Self) -> Self;
     /// Mask of the lanes where `self > o`.
@@ -54,20 +54,32 @@ pub trait Lane:
     fn bits(self) -> u32;
 }
 
+/// Eight `f32` lanes, loaded from and stored to arrays.
+pub trait Lane: LaneMath {
+    /// Lane `k` is `v[k]`.
+    fn new(v: [f32; LANES]) -> Self;
+    /// The lanes.
+    fn to_array(self) -> [f32; LANES];
+}
+
 impl Lane for f32x8 {
-    const ZERO: Self = f32x8::ZERO;
-    const ONE: Self = f32x8::ONE;
     #[inline(always)]
     fn new(v: [f32; LANES]) -> Self {
         f32x8::new(v)
     }
     #[inline(always)]
-    fn splat(v: f32) -> Self {
-        f32x8::splat(v)
-    }
-    #[inline(always)]
     fn to_array(self) -> [f32; LANES] {
         f32x8::to_array(self)
+    }
+}
+
+impl LaneMath for f32x8 {
+    const ZERO: Self = f32x8::ZERO;
+    const ONE: Self = f32x8::ONE;
+    const ALL: u32 = (1 << LANES) - 1;
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        f32x8::splat(v)
     }
     #[inline(always)]
     fn simd_lt(self, o: Self) -> Self {

@@ -8,7 +8,7 @@
 use std::arch::x86_64::*;
 use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
 
-use super::lane::{LANES, Lane};
+use super::lane::{LANES, Lane, LaneMath};
 
 /// Eight `f32` in an AVX register.
 #[derive(Debug, Clone, Copy)]
@@ -38,18 +38,9 @@ macro_rules! avx {
 }
 
 impl Lane for Avx {
-    // SAFETY: `__m256` is eight `f32`, any bits are valid.
-    const ZERO: Self = Avx(unsafe { std::mem::transmute::<[f32; LANES], __m256>([0.0; LANES]) });
-    // SAFETY: as above.
-    const ONE: Self = Avx(unsafe { std::mem::transmute::<[f32; LANES], __m256>([1.0; LANES]) });
-
     #[inline(always)]
     fn new(v: [f32; LANES]) -> Self {
         avx!(_mm256_loadu_ps(v.as_ptr()))
-    }
-    #[inline(always)]
-    fn splat(v: f32) -> Self {
-        avx!(_mm256_set1_ps(v))
     }
     #[inline(always)]
     fn to_array(self) -> [f32; LANES] {
@@ -57,6 +48,19 @@ impl Lane for Avx {
         // SAFETY: as `avx!`; `out` holds eight f32.
         unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) };
         out
+    }
+}
+
+impl LaneMath for Avx {
+    // SAFETY: `__m256` is eight `f32`, any bits are valid.
+    const ZERO: Self = Avx(unsafe { std::mem::transmute::<[f32; LANES], __m256>([0.0; LANES]) });
+    // SAFETY: as above.
+    const ONE: Self = Avx(unsafe { std::mem::transmute::<[f32; LANES], __m256>([1.0; LANES]) });
+    const ALL: u32 = (1 << LANES) - 1;
+
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        avx!(_mm256_set1_ps(v))
     }
     #[inline(always)]
     fn simd_lt(self, o: Self) -> Self {
@@ -95,11 +99,9 @@ impl Lane for Avx {
         // SAFETY: as `avx!`.
         unsafe { _mm256_movemask_ps(self.0) as u32 }
     }
-    /// The Cephes `logf` polynomial, as `wide` evaluates it: `x = m 2^e`, `m` in
-    /// [√½, √2), `ln x = e ln 2 + ln m` (ln 2 split in two), `ln(1 + f)` of degree 9.
+    /// The Cephes `logf` polynomial, as `wide` evaluates it ([`ln_of_parts`]).
     #[inline(always)]
     fn ln(self) -> Self {
-        let s = Avx::splat;
         // SAFETY: as `avx!` (AVX2 for the integer shifts).
         let (m, e) = unsafe {
             let bits = _mm256_castps_si256(self.0);
@@ -113,26 +115,36 @@ impl Lane for Avx {
                 Avx(_mm256_cvtepi32_ps(exponent)),
             )
         };
-        let small = m.simd_lt(s(std::f32::consts::FRAC_1_SQRT_2));
-        let e = e - (small & Avx::ONE);
-        let f = m - Avx::ONE + (small & m);
-        let z = f * f;
-        let mut y = s(7.037_683_6e-2);
-        for c in [
-            -1.151_461e-1,
-            1.167_699_9e-1,
-            -1.242_014_1e-1,
-            1.424_932_3e-1,
-            -1.666_805_8e-1,
-            2.000_071_5e-1,
-            -2.499_999_4e-1,
-            0.333_333_3,
-        ] {
-            y = y * f + s(c);
-        }
-        let y = y * f * z + e * s(-2.121_944_4e-4) - z * s(0.5);
-        f + y + e * s(0.693_359_4)
+        ln_of_parts(m, e)
     }
+}
+
+/// `ln x` from `x = m 2^e` with `m` in [½, 1) (the bits' mantissa and exponent): the
+/// Cephes `logf` polynomial as `wide` evaluates it: `m` moved to [√½, √2), then
+/// `ln x = e ln 2 + ln m` (ln 2 split in two), `ln(1 + f)` of degree 9. The AVX and
+/// AVX-512 lanes share it, so their lanes agree bit for bit.
+#[inline(always)]
+pub(super) fn ln_of_parts<L: LaneMath>(m: L, e: L) -> L {
+    let s = L::splat;
+    let small = m.simd_lt(s(std::f32::consts::FRAC_1_SQRT_2));
+    let e = e - (small & L::ONE);
+    let f = m - L::ONE + (small & m);
+    let z = f * f;
+    let mut y = s(7.037_683_6e-2);
+    for c in [
+        -1.151_461e-1,
+        1.167_699_9e-1,
+        -1.242_014_1e-1,
+        1.424_932_3e-1,
+        -1.666_805_8e-1,
+        2.000_071_5e-1,
+        -2.499_999_4e-1,
+        0.333_333_3,
+    ] {
+        y = y * f + s(c);
+    }
+    let y = y * f * z + e * s(-2.121_944_4e-4) - z * s(0.5);
+    f + y + e * s(0.693_359_4)
 }
 
 impl Add for Avx {
@@ -212,16 +224,21 @@ mod tests {
         same(pa * pb, xa * xb, "*", 0);
         same(pa / pb, xa / xb, "/", 0);
         same(-pa, -xa, "neg", 0);
-        same(Lane::abs(pb), Lane::abs(xb), "abs", 0);
-        same(Lane::sqrt(pa), Lane::sqrt(xa), "sqrt", 0);
-        same(Lane::max(pa, pb), Lane::max(xa, xb), "max", 0);
-        same(Lane::ln(pa), Lane::ln(xa), "ln", 1);
-        let (mp, mx) = (Lane::simd_lt(pa, pb), Lane::simd_lt(xa, xb));
+        same(LaneMath::abs(pb), LaneMath::abs(xb), "abs", 0);
+        same(LaneMath::sqrt(pa), LaneMath::sqrt(xa), "sqrt", 0);
+        same(LaneMath::max(pa, pb), LaneMath::max(xa, xb), "max", 0);
+        same(LaneMath::ln(pa), LaneMath::ln(xa), "ln", 1);
+        let (mp, mx) = (LaneMath::simd_lt(pa, pb), LaneMath::simd_lt(xa, xb));
         same(mp, mx, "<", 0);
-        same(Lane::simd_gt(pa, pb), Lane::simd_gt(xa, xb), ">", 0);
-        same(Lane::simd_ge(pa, pb), Lane::simd_ge(xa, xb), ">=", 0);
+        same(LaneMath::simd_gt(pa, pb), LaneMath::simd_gt(xa, xb), ">", 0);
+        same(
+            LaneMath::simd_ge(pa, pb),
+            LaneMath::simd_ge(xa, xb),
+            ">=",
+            0,
+        );
         same(mp & pa, mx & xa, "&", 0);
-        same(mp.select(pa, pb), Lane::select(mx, xa, xb), "select", 0);
+        same(mp.select(pa, pb), LaneMath::select(mx, xa, xb), "select", 0);
         let inf = [
             f32::INFINITY,
             f32::NAN,
@@ -233,8 +250,8 @@ mod tests {
             3.0,
         ];
         same(
-            Lane::is_finite(f32x8::new(inf)),
-            Lane::is_finite(Avx::new(inf)),
+            LaneMath::is_finite(f32x8::new(inf)),
+            LaneMath::is_finite(Avx::new(inf)),
             "is_finite",
             0,
         );

@@ -1,10 +1,12 @@
-//! One colour's tets projected eight at a time ([`super::rest_free_lanes`]): load a
+//! One colour's tets projected eight (or sixteen) at a time ([`super::rest_free_lanes`]): load a
 //! [`LaneBlock`]'s terms lane by lane, read its tets' nodes into the lanes, project, write
 //! the live ones back ([`super::lane_nodes`]).
 
+#[cfg(target_arch = "x86_64")]
+use super::lane_avx::Avx;
 use super::lane_nodes::NodeLanes;
 use super::lane_slots::{LaneBlock, LaneSlots};
-use super::lanes::{LANES, M3};
+use super::lanes::{LANES, M3, V3};
 use super::rest_free_lanes::{TetLanes, project_rest_free_lanes};
 use super::shared_nodes::SharedNodes;
 
@@ -22,27 +24,61 @@ unsafe fn project_block<L: NodeLanes>(
     inv_mass: &[f32],
 ) {
     // SAFETY: the caller's contract.
+    let mut lanes = unsafe { block_lanes::<L>(b, nodes, inv_mass) };
+    let dl_h = project_rest_free_lanes(&mut lanes);
+    // SAFETY: the caller's contract.
+    unsafe { finish_block(b, &lanes.u, dl_h, lambdas, base, nodes) };
+}
+
+/// The block's tets in lanes: their terms and their nodes' values.
+///
+/// # Safety
+/// As [`project_block`].
+#[inline(always)]
+unsafe fn block_lanes<L: NodeLanes>(
+    b: &LaneBlock,
+    nodes: &SharedNodes,
+    inv_mass: &[f32],
+) -> TetLanes<L> {
+    // SAFETY: the caller's contract.
     let (u, w) = unsafe { L::load_nodes(b, nodes, inv_mass) };
-    let mut lanes = TetLanes {
+    TetLanes {
         u,
         w,
         dm_inv: M3::load(&b.dm_inv),
         alpha_h: L::new(b.alpha_h),
         alpha_d: L::new(b.alpha_d),
         live: L::new(b.live),
-    };
-    let dl_h = project_rest_free_lanes(&mut lanes).to_array();
+    }
+}
+
+/// Write the block's projected displacements `u` and multipliers `dl_h` (live lanes only).
+///
+/// # Safety
+/// As [`project_block`].
+#[inline(always)]
+unsafe fn finish_block<L: NodeLanes>(
+    b: &LaneBlock,
+    u: &[V3<L>; 4],
+    dl_h: L,
+    lambdas: &mut [f32],
+    base: usize,
+    nodes: &SharedNodes,
+) {
     // SAFETY: the caller's contract.
-    unsafe { L::store_nodes(b, &lanes.u, nodes) };
+    unsafe { L::store_nodes(b, u, nodes) };
+    let dl_h = dl_h.to_array();
     let first = b.first as usize - base;
     for k in (0..LANES).filter(|&k| b.is_live(k)) {
         lambdas[first + k] = dl_h[k];
     }
 }
 
-/// Project a run of one colour's blocks, block by block: in one AVX register per lane
-/// value where `detect` is set and the CPU has AVX2 (checked at run time, so a portable
-/// build uses it too), else with `wide`'s lanes at the build's instruction set. `lambdas`
+/// Project a run of one colour's blocks: two blocks at a time in one AVX-512 register per
+/// lane value where `detect` is set and the CPU has AVX-512F, block by block in one AVX
+/// register where it has AVX2 (both checked at run time, so a portable build uses them
+/// too), else with `wide`'s lanes at the build's instruction set. Each tet's bits are
+/// the same on all three. `lambdas`
 /// holds the multipliers of the blocks' slots ([`LaneSlots::slot_range`]).
 ///
 /// # Safety
@@ -54,6 +90,11 @@ pub(super) unsafe fn project_run(
     inv_mass: &[f32],
     detect: bool,
 ) {
+    #[cfg(target_arch = "x86_64")]
+    if detect && has_avx512() {
+        // SAFETY: the CPU has AVX-512F (and so AVX2); the rest is the caller's contract.
+        return unsafe { project_run_avx512(blocks, lambdas, nodes, inv_mass) };
+    }
     #[cfg(target_arch = "x86_64")]
     if detect && std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2; the rest is the caller's contract.
@@ -77,7 +118,71 @@ unsafe fn project_run_avx2(
     inv_mass: &[f32],
 ) {
     // SAFETY: the caller's contract.
-    unsafe { project_blocks::<super::lane_avx::Avx>(blocks, lambdas, nodes, inv_mass) }
+    unsafe { project_blocks::<Avx>(blocks, lambdas, nodes, inv_mass) }
+}
+
+/// Whether the CPU has AVX-512F and this build its lanes (Rust 1.89 and later: build.rs).
+#[cfg(all(target_arch = "x86_64", incise_avx512))]
+fn has_avx512() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+}
+
+/// Whether the CPU has AVX-512F and this build its lanes: not before Rust 1.89.
+#[cfg(all(target_arch = "x86_64", not(incise_avx512)))]
+fn has_avx512() -> bool {
+    false
+}
+
+/// Never called: [`has_avx512`] is false before Rust 1.89.
+///
+/// # Safety
+/// As [`project_run_avx2`].
+#[cfg(all(target_arch = "x86_64", not(incise_avx512)))]
+unsafe fn project_run_avx512(
+    blocks: &[LaneBlock],
+    lambdas: &mut [f32],
+    nodes: &SharedNodes,
+    inv_mass: &[f32],
+) {
+    // SAFETY: the caller's contract.
+    unsafe { project_run_avx2(blocks, lambdas, nodes, inv_mass) }
+}
+
+/// The run two blocks at a time in [`super::lane_avx512::Avx512`] lanes (the blocks of a run share no node,
+/// so their order does not matter), compiled for AVX-512F; an odd last block in
+/// [`Avx`] lanes.
+///
+/// # Safety
+/// The CPU must have AVX-512F; otherwise as [`project_block`].
+#[cfg(all(target_arch = "x86_64", incise_avx512))]
+#[allow(clippy::incompatible_msrv)]
+#[target_feature(enable = "avx,avx2,avx512f")]
+unsafe fn project_run_avx512(
+    blocks: &[LaneBlock],
+    lambdas: &mut [f32],
+    nodes: &SharedNodes,
+    inv_mass: &[f32],
+) {
+    use super::lane_avx512::{join_tets, split_displacements};
+    let base = LaneSlots::slot_range(blocks).start;
+    let mut pairs = blocks.chunks_exact(2);
+    for pair in &mut pairs {
+        let (lo, hi) = (&pair[0], &pair[1]);
+        // SAFETY: the caller's contract (the blocks are of one colour: no node in both).
+        unsafe {
+            let a = block_lanes::<Avx>(lo, nodes, inv_mass);
+            let b = block_lanes::<Avx>(hi, nodes, inv_mass);
+            let mut lanes = join_tets(&a, &b);
+            let (dl_lo, dl_hi) = project_rest_free_lanes(&mut lanes).split();
+            let (u_lo, u_hi) = split_displacements(&lanes.u);
+            finish_block(lo, &u_lo, dl_lo, lambdas, base, nodes);
+            finish_block(hi, &u_hi, dl_hi, lambdas, base, nodes);
+        }
+    }
+    for b in pairs.remainder() {
+        // SAFETY: the caller's contract.
+        unsafe { project_block::<Avx>(b, lambdas, base, nodes, inv_mass) };
+    }
 }
 
 /// The run, block by block, compiled into its caller.
@@ -95,5 +200,94 @@ unsafe fn project_blocks<L: NodeLanes>(
     for b in blocks {
         // SAFETY: the caller's contract.
         unsafe { project_block::<L>(b, lambdas, base, nodes, inv_mass) };
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use glam::{Mat3, Vec3};
+
+    use super::*;
+    use crate::xpbd::neo_hookean::TetTerms;
+    use crate::xpbd::tet_slot::TetSlot;
+
+    /// 37 tets on disjoint nodes (four full blocks and one of five: two pairs and an odd
+    /// block), strained from nothing to inverted, some flattened below J_MIN, some without
+    /// a volume constraint, tets 4 and 21 not live.
+    fn slots() -> LaneSlots {
+        let slots: Vec<TetSlot> = (0..37u32)
+            .map(|s| {
+                let f = (s % 10) as f32;
+                TetSlot {
+                    nodes: [4 * s, 4 * s + 1, 4 * s + 2, 4 * s + 3],
+                    terms: TetTerms {
+                        dm_inv: Mat3::from_diagonal(Vec3::new(1.0, 1.1, 0.9 + 0.01 * f)),
+                        alpha_h: if s % 5 == 3 {
+                            f32::INFINITY
+                        } else {
+                            0.2 + 0.01 * f
+                        },
+                        alpha_d: 0.3 + 0.05 * f,
+                        gamma: 1.0,
+                    },
+                    live: s != 4 && s != 21,
+                }
+            })
+            .collect();
+        LaneSlots::new(&slots, std::iter::once(0..37))
+    }
+
+    /// Node `i`'s displacement from rest: tet `i / 4` strained by its number.
+    fn displacement(i: usize) -> Vec3 {
+        let (s, j) = (i / 4, i % 4);
+        let a = (s % 7) as f32 * 0.04;
+        match (s % 9, j) {
+            (6, 3) => Vec3::new(0.0, 0.0, -0.95),
+            (7, 3) => Vec3::new(0.1, 0.0, -1.4),
+            (6 | 7, _) => Vec3::ZERO,
+            _ => Vec3::new(0.3 * a * j as f32, -0.1 * a, 0.05 * a * (j as f32 - 1.5)),
+        }
+    }
+
+    /// The bits of every node and multiplier after `project` ran the whole run.
+    fn run(
+        project: unsafe fn(&[LaneBlock], &mut [f32], &SharedNodes, &[f32]),
+    ) -> (Vec<[u32; 3]>, Vec<u32>) {
+        let slots = slots();
+        let mut x: Vec<Vec3> = (0..4 * 37).map(displacement).collect();
+        let w: Vec<f32> = (0..4 * 37).map(|i| 1.0 / (1.0 + (i % 5) as f32)).collect();
+        let mut lambdas = vec![-1.0f32; LaneSlots::slot_range(&slots.blocks).len()];
+        let shared = SharedNodes::new(&mut x);
+        // SAFETY: one thread; the run is one colour (disjoint nodes).
+        unsafe { project(&slots.blocks, &mut lambdas, &shared, &w) };
+        let nodes = x.iter().map(|p| p.to_array().map(f32::to_bits)).collect();
+        (nodes, lambdas.iter().map(|l| l.to_bits()).collect())
+    }
+
+    /// Two blocks in one AVX-512 register give every tet the bits one block in an AVX
+    /// register gives it: the nodes, the multipliers, the dead tets and padding left as
+    /// they were; where the CPU has AVX-512F. Broken on purpose once (the pair's
+    /// multipliers written to each other's block): fails.
+    #[test]
+    fn avx512_pairs_project_what_avx_blocks_project() {
+        if !has_avx512() {
+            eprintln!("skipping: no AVX-512F");
+            return;
+        }
+        let (avx_nodes, avx_lambdas) = run(project_run_avx2);
+        let (wide_nodes, wide_lambdas) = run(project_run_avx512);
+        let at_rest: Vec<[u32; 3]> = (0..4 * 37)
+            .map(|i| displacement(i).to_array().map(f32::to_bits))
+            .collect();
+        let moved = (0..4 * 37).filter(|&i| avx_nodes[i] != at_rest[i]).count();
+        assert!(moved > 80, "only {moved} nodes moved");
+        for dead in [4usize, 21] {
+            assert_eq!(
+                avx_nodes[4 * dead..4 * dead + 4],
+                at_rest[4 * dead..4 * dead + 4]
+            );
+        }
+        assert_eq!(wide_nodes, avx_nodes, "nodes");
+        assert_eq!(wide_lambdas, avx_lambdas, "multipliers");
     }
 }

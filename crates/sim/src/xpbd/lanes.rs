@@ -5,7 +5,7 @@
 
 use std::ops::{Add, Mul, Neg, Sub};
 
-pub use super::lane::{LANES, Lane};
+pub use super::lane::{LANES, Lane, LaneMath};
 
 /// A 3-vector per lane.
 #[derive(Debug, Clone, Copy)]
@@ -18,7 +18,7 @@ pub struct V3<L> {
     pub z: L,
 }
 
-impl<L: Lane> V3<L> {
+impl<L: LaneMath> V3<L> {
     /// The zero vector in every lane.
     pub const ZERO: V3<L> = V3 {
         x: L::ZERO,
@@ -26,6 +26,30 @@ impl<L: Lane> V3<L> {
         z: L::ZERO,
     };
 
+    /// Dot product per lane.
+    #[inline(always)]
+    pub fn dot(self, o: V3<L>) -> L {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// Squared length per lane.
+    #[inline(always)]
+    pub fn length_squared(self) -> L {
+        self.dot(self)
+    }
+
+    /// Cross product per lane.
+    #[inline(always)]
+    pub fn cross(self, o: V3<L>) -> V3<L> {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+}
+
+impl<L: Lane> V3<L> {
     /// The vector stored component by component (`soa[c][k]`: component c of lane k):
     /// three contiguous loads.
     #[inline(always)]
@@ -63,31 +87,9 @@ impl<L: Lane> V3<L> {
     pub fn to_arrays(self) -> [[f32; LANES]; 3] {
         [self.x.to_array(), self.y.to_array(), self.z.to_array()]
     }
-
-    /// Dot product per lane.
-    #[inline(always)]
-    pub fn dot(self, o: V3<L>) -> L {
-        self.x * o.x + self.y * o.y + self.z * o.z
-    }
-
-    /// Squared length per lane.
-    #[inline(always)]
-    pub fn length_squared(self) -> L {
-        self.dot(self)
-    }
-
-    /// Cross product per lane.
-    #[inline(always)]
-    pub fn cross(self, o: V3<L>) -> V3<L> {
-        V3 {
-            x: self.y * o.z - o.y * self.z,
-            y: self.z * o.x - o.z * self.x,
-            z: self.x * o.y - o.x * self.y,
-        }
-    }
 }
 
-impl<L: Lane> Add for V3<L> {
+impl<L: LaneMath> Add for V3<L> {
     type Output = V3<L>;
     #[inline(always)]
     fn add(self, o: V3<L>) -> V3<L> {
@@ -99,7 +101,7 @@ impl<L: Lane> Add for V3<L> {
     }
 }
 
-impl<L: Lane> Sub for V3<L> {
+impl<L: LaneMath> Sub for V3<L> {
     type Output = V3<L>;
     #[inline(always)]
     fn sub(self, o: V3<L>) -> V3<L> {
@@ -111,7 +113,7 @@ impl<L: Lane> Sub for V3<L> {
     }
 }
 
-impl<L: Lane> Neg for V3<L> {
+impl<L: LaneMath> Neg for V3<L> {
     type Output = V3<L>;
     #[inline(always)]
     fn neg(self) -> V3<L> {
@@ -123,7 +125,7 @@ impl<L: Lane> Neg for V3<L> {
     }
 }
 
-impl<L: Lane> Mul<L> for V3<L> {
+impl<L: LaneMath> Mul<L> for V3<L> {
     type Output = V3<L>;
     #[inline(always)]
     fn mul(self, s: L) -> V3<L> {
@@ -146,7 +148,7 @@ pub struct M3<L> {
     pub c2: V3<L>,
 }
 
-impl<L: Lane> M3<L> {
+impl<L: LaneMath> M3<L> {
     /// `s · I` per lane.
     #[inline(always)]
     pub fn diagonal(s: L) -> M3<L> {
@@ -155,32 +157,6 @@ impl<L: Lane> M3<L> {
             c0: V3 { x: s, y: z, z },
             c1: V3 { x: z, y: s, z },
             c2: V3 { x: z, y: z, z: s },
-        }
-    }
-
-    /// The matrix stored entry by entry, column-major (`soa[3c + r][k]`: row r of column
-    /// c in lane k, as [`store_mat`] writes it): nine contiguous loads.
-    #[inline(always)]
-    pub fn load(soa: &[[f32; LANES]; 9]) -> M3<L> {
-        let col = |c: usize| V3 {
-            x: L::new(soa[3 * c]),
-            y: L::new(soa[3 * c + 1]),
-            z: L::new(soa[3 * c + 2]),
-        };
-        M3 {
-            c0: col(0),
-            c1: col(1),
-            c2: col(2),
-        }
-    }
-
-    /// Lane `k` of the result is `m[k]`.
-    #[inline(always)]
-    pub fn gather(m: &[glam::Mat3; LANES]) -> M3<L> {
-        M3 {
-            c0: V3::gather(&m.map(|a| a.x_axis)),
-            c1: V3::gather(&m.map(|a| a.y_axis)),
-            c2: V3::gather(&m.map(|a| a.z_axis)),
         }
     }
 
@@ -252,6 +228,34 @@ impl<L: Lane> M3<L> {
     pub fn norm2(&self) -> L {
         self.c0.length_squared() + self.c1.length_squared() + self.c2.length_squared()
     }
+}
+
+impl<L: Lane> M3<L> {
+    /// The matrix stored entry by entry, column-major (`soa[3c + r][k]`: row r of column
+    /// c in lane k, as [`store_mat`] writes it): nine contiguous loads.
+    #[inline(always)]
+    pub fn load(soa: &[[f32; LANES]; 9]) -> M3<L> {
+        let col = |c: usize| V3 {
+            x: L::new(soa[3 * c]),
+            y: L::new(soa[3 * c + 1]),
+            z: L::new(soa[3 * c + 2]),
+        };
+        M3 {
+            c0: col(0),
+            c1: col(1),
+            c2: col(2),
+        }
+    }
+
+    /// Lane `k` of the result is `m[k]`.
+    #[inline(always)]
+    pub fn gather(m: &[glam::Mat3; LANES]) -> M3<L> {
+        M3 {
+            c0: V3::gather(&m.map(|a| a.x_axis)),
+            c1: V3::gather(&m.map(|a| a.y_axis)),
+            c2: V3::gather(&m.map(|a| a.z_axis)),
+        }
+    }
 
     /// The entries as arrays, column-major as [`M3::load`] reads them.
     #[inline(always)]
@@ -263,7 +267,7 @@ impl<L: Lane> M3<L> {
     }
 }
 
-impl<L: Lane> Add for M3<L> {
+impl<L: LaneMath> Add for M3<L> {
     type Output = M3<L>;
     #[inline(always)]
     fn add(self, o: M3<L>) -> M3<L> {
@@ -275,7 +279,7 @@ impl<L: Lane> Add for M3<L> {
     }
 }
 
-impl<L: Lane> Sub for M3<L> {
+impl<L: LaneMath> Sub for M3<L> {
     type Output = M3<L>;
     #[inline(always)]
     fn sub(self, o: M3<L>) -> M3<L> {
@@ -287,7 +291,7 @@ impl<L: Lane> Sub for M3<L> {
     }
 }
 
-impl<L: Lane> Mul<L> for M3<L> {
+impl<L: LaneMath> Mul<L> for M3<L> {
     type Output = M3<L>;
     #[inline(always)]
     fn mul(self, s: L) -> M3<L> {

@@ -7,6 +7,11 @@ mod implicit_step;
 mod lane;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod lane_avx;
+// The AVX-512 intrinsics are stable since Rust 1.89 (build.rs); before it the AVX lanes
+// serve alone.
+#[cfg(all(target_arch = "x86_64", incise_avx512))]
+#[allow(clippy::incompatible_msrv)]
+mod lane_avx512;
 pub(crate) mod lane_nodes;
 mod lane_pass;
 mod lane_slots;

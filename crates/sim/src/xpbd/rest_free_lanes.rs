@@ -4,7 +4,7 @@
 //! branch of the reference evaluated in every lane and chosen by a mask. Tets of one colour
 //! share no node, so eight of them are independent (PHYSICS.md §1.2, parallel form).
 
-use super::lanes::{Lane, M3, V3};
+use super::lanes::{LaneMath, M3, V3};
 use super::rest_free::{J_MIN, MIN_SHAPE};
 use super::strain::SERIES_LIMIT;
 
@@ -29,7 +29,7 @@ pub struct TetLanes<L> {
 /// `x − ln(1 + x)`: the series below [`SERIES_LIMIT`], else direct (strain.rs
 /// `log1p_excess`).
 #[inline(always)]
-pub(crate) fn log1p_excess<L: Lane>(x: L) -> L {
+pub(crate) fn log1p_excess<L: LaneMath>(x: L) -> L {
     let series = x.abs().simd_lt(L::splat(SERIES_LIMIT));
     match Taken::of(series) {
         Taken::All => log1p_excess_series(x),
@@ -40,7 +40,7 @@ pub(crate) fn log1p_excess<L: Lane>(x: L) -> L {
 
 /// `x − ln(1 + x)` by its series.
 #[inline(always)]
-fn log1p_excess_series<L: Lane>(x: L) -> L {
+fn log1p_excess_series<L: LaneMath>(x: L) -> L {
     let s = L::splat;
     let x2 = x * x;
     let tail = s(-1.0 / 7.0) + x * s(0.125);
@@ -50,7 +50,7 @@ fn log1p_excess_series<L: Lane>(x: L) -> L {
 
 /// `x − ln(1 + x)` directly.
 #[inline(always)]
-fn log1p_excess_direct<L: Lane>(x: L) -> L {
+fn log1p_excess_direct<L: LaneMath>(x: L) -> L {
     x - (L::ONE + x).ln()
 }
 
@@ -69,10 +69,10 @@ pub(crate) enum Taken {
 impl Taken {
     /// The lanes `mask` sets.
     #[inline(always)]
-    pub(crate) fn of<L: Lane>(mask: L) -> Taken {
+    pub(crate) fn of<L: LaneMath>(mask: L) -> Taken {
         match mask.bits() {
             0 => Taken::None,
-            b if b == (1 << super::lane::LANES) - 1 => Taken::All,
+            b if b == L::ALL => Taken::All,
             _ => Taken::Some,
         }
     }
@@ -94,7 +94,7 @@ pub(crate) struct StrainLanes<L> {
     pub(crate) cof_h: M3<L>,
 }
 
-impl<L: Lane> StrainLanes<L> {
+impl<L: LaneMath> StrainLanes<L> {
     /// The invariants of `I + h`.
     #[inline(always)]
     pub(crate) fn of(h: M3<L>) -> Self {
@@ -130,7 +130,7 @@ impl<L: Lane> StrainLanes<L> {
 /// `excess = log1p_excess(J − 1)`.
 // docs/physics-notes.md, rest-free pair, C_H.
 #[inline(always)]
-pub(crate) fn log_volume<L: Lane>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
+pub(crate) fn log_volume<L: LaneMath>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
     let j = L::ONE + s.j1;
     let above = j.simd_gt(L::splat(J_MIN));
     let l_above = || s.j1 - excess;
@@ -150,7 +150,7 @@ pub(crate) fn log_volume<L: Lane>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
 /// `log_volume` and the excess.
 // docs/physics-notes.md, rest-free pair, C_D² = ψ̂.
 #[inline(always)]
-pub(crate) fn shape_energy<L: Lane>(
+pub(crate) fn shape_energy<L: LaneMath>(
     s: &StrainLanes<L>,
     volume: (L, L, L),
     excess: L,
@@ -178,7 +178,7 @@ pub(crate) fn shape_energy<L: Lane>(
 /// (rest_free.rs `shape_constraint`), given `log_volume` and the excess.
 // docs/physics-notes.md, rest-free pair, C_D.
 #[inline(always)]
-fn shape_constraint<L: Lane>(
+fn shape_constraint<L: LaneMath>(
     s: &StrainLanes<L>,
     volume: (L, L, L),
     excess: L,
@@ -192,7 +192,7 @@ fn shape_constraint<L: Lane>(
 
 /// `a` in the lanes where `m` is set, else `b`.
 #[inline(always)]
-pub(crate) fn select_v3<L: Lane>(m: L, a: V3<L>, b: V3<L>) -> V3<L> {
+pub(crate) fn select_v3<L: LaneMath>(m: L, a: V3<L>, b: V3<L>) -> V3<L> {
     V3 {
         x: m.select(a.x, b.x),
         y: m.select(a.y, b.y),
@@ -202,7 +202,7 @@ pub(crate) fn select_v3<L: Lane>(m: L, a: V3<L>, b: V3<L>) -> V3<L> {
 
 /// `a` in the lanes where `m` is set, else `b`.
 #[inline(always)]
-pub(crate) fn select_m3<L: Lane>(m: L, a: &M3<L>, b: &M3<L>) -> M3<L> {
+pub(crate) fn select_m3<L: LaneMath>(m: L, a: &M3<L>, b: &M3<L>) -> M3<L> {
     M3 {
         c0: select_v3(m, a.c0, b.c0),
         c1: select_v3(m, a.c1, b.c1),
@@ -213,20 +213,20 @@ pub(crate) fn select_m3<L: Lane>(m: L, a: &M3<L>, b: &M3<L>) -> M3<L> {
 /// `G = (∂C/∂F) Dm⁻ᵀ`: `∇x1..3` = columns of G, `∇x0 = −(∇x1+∇x2+∇x3)`.
 // PHYSICS.md §1.2, vertex gradients.
 #[inline(always)]
-fn vertex_gradients<L: Lane>(dcdf: &M3<L>, dm_inv_t: &M3<L>) -> [V3<L>; 4] {
+fn vertex_gradients<L: LaneMath>(dcdf: &M3<L>, dm_inv_t: &M3<L>) -> [V3<L>; 4] {
     let g = dcdf.mul_mat(dm_inv_t);
     [-(g.c0 + g.c1 + g.c2), g.c0, g.c1, g.c2]
 }
 
 #[inline(always)]
-fn weighted_dot<L: Lane>(w: &[L; 4], a: &[V3<L>; 4], b: &[V3<L>; 4]) -> L {
+fn weighted_dot<L: LaneMath>(w: &[L; 4], a: &[V3<L>; 4], b: &[V3<L>; 4]) -> L {
     w[0] * a[0].dot(b[0]) + w[1] * a[1].dot(b[1]) + w[2] * a[2].dot(b[2]) + w[3] * a[3].dot(b[3])
 }
 
 /// One row of the 2×2 system, or an empty row (zero gradient and value, unit compliance)
 /// where its constraint does not apply.
 #[inline(always)]
-fn row<L: Lane>(on: L, g: [V3<L>; 4], c: L, alpha: L) -> ([V3<L>; 4], L, L) {
+fn row<L: LaneMath>(on: L, g: [V3<L>; 4], c: L, alpha: L) -> ([V3<L>; 4], L, L) {
     if Taken::of(on) == Taken::All {
         return (g, c, alpha);
     }
@@ -248,7 +248,7 @@ fn row<L: Lane>(on: L, g: [V3<L>; 4], c: L, alpha: L) -> ([V3<L>; 4], L, L) {
 // PHYSICS.md §1.2, XPBD update (block form, λ = 0 at the start of the substep);
 // docs/physics-notes.md, rest-free pair.
 #[inline(always)]
-pub fn project_rest_free_lanes<L: Lane>(t: &mut TetLanes<L>) -> L {
+pub fn project_rest_free_lanes<L: LaneMath>(t: &mut TetLanes<L>) -> L {
     let du = M3 {
         c0: t.u[1] - t.u[0],
         c1: t.u[2] - t.u[0],
@@ -298,7 +298,7 @@ mod tests {
     use glam::{Mat3, Vec3};
 
     use super::*;
-    use crate::xpbd::lanes::LANES;
+    use crate::xpbd::lanes::{LANES, Lane};
     use crate::xpbd::neo_hookean::{TetProjection, TetTerms};
     use crate::xpbd::rest_free::project_rest_free;
 
