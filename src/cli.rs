@@ -308,8 +308,10 @@ pub enum MeshCommand {
 /// Which CPU kernel projects the tets (`incise bench realtime --cpu-kernel`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum KernelChoice {
-    /// Eight tets at once in SIMD lanes, AVX2 where the CPU has it (the default).
+    /// Eight tets at once in SIMD lanes, AVX-512 or AVX2 where the CPU has it (the default).
     Lanes,
+    /// The same lanes, never wider than AVX2 (what an AVX2-only CPU runs).
+    Avx2Lanes,
     /// The same lanes at the build's own instruction set (no AVX2 detection).
     PortableLanes,
     /// One tet at a time (the reference).
@@ -320,6 +322,7 @@ impl From<KernelChoice> for incise_sim::xpbd::CpuKernel {
     fn from(k: KernelChoice) -> Self {
         match k {
             KernelChoice::Lanes => incise_sim::xpbd::CpuKernel::Lanes,
+            KernelChoice::Avx2Lanes => incise_sim::xpbd::CpuKernel::Avx2Lanes,
             KernelChoice::PortableLanes => incise_sim::xpbd::CpuKernel::PortableLanes,
             KernelChoice::Scalar => incise_sim::xpbd::CpuKernel::Scalar,
         }

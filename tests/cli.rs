@@ -320,6 +320,7 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
             "PortableLanes",
             "Lanes",
             "Lanes, Blocks",
+            "Avx2Lanes, Blocks",
             "Newton"
         ],
         "{out}"

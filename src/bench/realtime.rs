@@ -26,7 +26,7 @@ pub struct RealtimeResult {
     pub scene: String,
     /// "cpu (N threads)" or the GPU adapter.
     pub device: String,
-    /// The CPU projection kernel ("Lanes", "PortableLanes" or "Scalar"; the GPU ignores
+    /// The CPU projection kernel ("Lanes", "Avx2Lanes", "PortableLanes" or "Scalar"; the GPU ignores
     /// it), with ", Blocks" for the partitioned sweep; "Newton" for the implicit scheme.
     pub cpu_kernel: String,
     /// The time integrator: "XPBD" or "Newton".
@@ -97,6 +97,7 @@ pub fn run(
                 (CpuKernel::PortableLanes, Some(CpuSweep::Coloured), xpbd),
                 (CpuKernel::Lanes, Some(CpuSweep::Coloured), xpbd),
                 (CpuKernel::Lanes, Some(CpuSweep::Blocks), xpbd),
+                (CpuKernel::Avx2Lanes, Some(CpuSweep::Blocks), xpbd),
             ],
         };
         let on_cpu = device != DeviceChoice::Gpu;

@@ -74,8 +74,19 @@ unsafe fn finish_block<L: NodeLanes>(
     }
 }
 
+/// The widest instructions the lanes look for at run time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Simd {
+    /// AVX-512F, else AVX2, else the build's own.
+    Widest,
+    /// AVX2, else the build's own.
+    Avx2,
+    /// The build's own (`wide`'s lanes; SSE2 in the portable x86-64 build).
+    Build,
+}
+
 /// Project a run of one colour's blocks: two blocks at a time in one AVX-512 register per
-/// lane value where `detect` is set and the CPU has AVX-512F, block by block in one AVX
+/// lane value where `simd` allows it and the CPU has AVX-512F, block by block in one AVX
 /// register where it has AVX2 (both checked at run time, so a portable build uses them
 /// too), else with `wide`'s lanes at the build's instruction set. Each tet's bits are
 /// the same on all three. `lambdas`
@@ -88,19 +99,19 @@ pub(super) unsafe fn project_run(
     lambdas: &mut [f32],
     nodes: &SharedNodes,
     inv_mass: &[f32],
-    detect: bool,
+    simd: Simd,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if detect && has_avx512() {
+    if simd == Simd::Widest && has_avx512() {
         // SAFETY: the CPU has AVX-512F (and so AVX2); the rest is the caller's contract.
         return unsafe { project_run_avx512(blocks, lambdas, nodes, inv_mass) };
     }
     #[cfg(target_arch = "x86_64")]
-    if detect && std::arch::is_x86_feature_detected!("avx2") {
+    if simd != Simd::Build && std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2; the rest is the caller's contract.
         return unsafe { project_run_avx2(blocks, lambdas, nodes, inv_mass) };
     }
-    let _ = detect;
+    let _ = simd;
     // SAFETY: the caller's contract.
     unsafe { project_blocks::<wide::f32x8>(blocks, lambdas, nodes, inv_mass) }
 }

@@ -16,10 +16,15 @@ pub const DEFAULT_RELEASE_INTERVAL: f32 = 1.0 / 240.0;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum CpuKernel {
     /// Eight tets of a colour at once in SIMD lanes, for the rest-free coupled pair (the
-    /// other pairs and modes run scalar), in AVX registers where the CPU has AVX2 (detected
-    /// at run time); matches `Scalar` to rounding (tested).
+    /// other pairs and modes run scalar): sixteen (two blocks) in AVX-512 registers where
+    /// the CPU has AVX-512F, else in AVX registers where it has AVX2 (detected at run
+    /// time), the same bits either way; matches `Scalar` to rounding (tested).
     #[default]
     Lanes,
+    /// The lanes in AVX registers even where the CPU has AVX-512 (AVX2 detected at run
+    /// time, else the build's own): for measuring what AVX-512 buys, and the path of an
+    /// AVX2-only CPU on an AVX-512 one. The same bits as `Lanes`.
+    Avx2Lanes,
     /// The same lanes at the build's own instruction set, no run-time detection (SSE2 in
     /// the portable x86-64 build): for measuring what AVX2 buys.
     PortableLanes,

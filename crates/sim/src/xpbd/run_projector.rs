@@ -4,7 +4,7 @@
 
 use std::ops::Range;
 
-use super::lane_pass;
+use super::lane_pass::{self, Simd};
 use super::lane_slots::LaneSlots;
 use super::neo_hookean::{ConstraintPair, TetProjection};
 use super::shared_nodes::SharedNodes;
@@ -39,19 +39,20 @@ impl SharedLambdas {
 pub(crate) struct RunProjector<'a> {
     inv_mass: &'a [f32],
     slots: &'a [TetSlot],
-    /// The packed blocks, and whether to detect AVX2, when the lanes project.
-    lanes: Option<(&'a LaneSlots, bool)>,
+    /// The packed blocks, and the widest instructions to look for, when the lanes project.
+    lanes: Option<(&'a LaneSlots, Simd)>,
     mode: TetProjection,
     pair: ConstraintPair,
 }
 
 impl<'a> RunProjector<'a> {
     /// Whether `params` project with the SIMD lanes (the rest-free coupled pair with a
-    /// lane kernel), and if so whether with run-time AVX2 detection.
-    pub fn lane_kernel(params: &SolverParams) -> Option<bool> {
+    /// lane kernel), and if so the widest instructions to look for at run time.
+    pub fn lane_kernel(params: &SolverParams) -> Option<Simd> {
         let lanes = match params.cpu_kernel {
-            CpuKernel::Lanes => Some(true),
-            CpuKernel::PortableLanes => Some(false),
+            CpuKernel::Lanes => Some(Simd::Widest),
+            CpuKernel::Avx2Lanes => Some(Simd::Avx2),
+            CpuKernel::PortableLanes => Some(Simd::Build),
             CpuKernel::Scalar => None,
         };
         lanes.filter(|_| {
@@ -92,14 +93,14 @@ impl<'a> RunProjector<'a> {
         nodes: &SharedNodes,
         (p, parts): (usize, usize),
     ) {
-        if let Some((packed, detect)) = self.lanes {
+        if let Some((packed, simd)) = self.lanes {
             let span = packed.spans[k].clone();
             let blocks = &packed.blocks[span.start..span.end][share(span.len(), p, parts)];
             // SAFETY: a colour's tets share no node and each part has its own blocks,
             // whose slots are their own; the rest is the caller's contract.
             unsafe {
                 let l = lambdas.run(LaneSlots::slot_range(blocks));
-                lane_pass::project_run(blocks, l, nodes, self.inv_mass, detect)
+                lane_pass::project_run(blocks, l, nodes, self.inv_mass, simd)
             };
             return;
         }
