@@ -168,9 +168,13 @@ impl Live {
         let frames = self.body.frames();
         let outcome = self.body.body.outcome().map(|o| o.summary);
         let lines = self.body.live_lines();
+        let ahead = self.body.ahead_ms();
         let mut out = format!("preview of {}: {frames} frames", self.body.scene_name());
         if let Some(o) = outcome {
             out += &format!(", {o}");
+        }
+        if let Some(ms) = ahead {
+            out += &format!("\nwork done between frames, before their input: {ms:.1} ms");
         }
         out += &format!("\n{}", self.body.close(None)?);
         for line in lines {

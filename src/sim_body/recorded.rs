@@ -70,6 +70,20 @@ impl RecordedBody {
         self.report.frames.last().map(|f| &f.stats)
     }
 
+    /// A tet body's pose-free work done between frames, before each took its input
+    /// (`ahead_ms` summed over the frames: the implicit scheme's refactorisation after
+    /// releases); `None` for the other models.
+    pub fn ahead_ms(&self) -> Option<f64> {
+        let mut frames = self.report.frames.iter().peekable();
+        frames.peek()?;
+        frames
+            .map(|f| match &f.stats {
+                FrameData::Xpbd(s) => Some(s.ahead_ms),
+                FrameData::Edges(_) => None,
+            })
+            .sum()
+    }
+
     /// The last frame's localisation as a live view shows it: the level chosen (by the
     /// refresh-rate manager under a budget) and the loop's time split; empty for other
     /// methods and before the first frame.
