@@ -1,7 +1,8 @@
 //! The rest-free pair's coupled projection for eight tets at once (one per SIMD lane):
 //! the same formulas, in the same order, as the scalar reference
 //! ([`super::rest_free`], [`super::strain`], [`super::neo_hookean::apply_pair`]), with each
-//! branch of the reference evaluated in every lane and chosen by a mask. Tets of one colour
+//! branch of the reference evaluated where a lane of the block takes it and chosen by a
+//! mask ([`Taken`]). Tets of one colour
 //! share no node, so eight of them are independent (PHYSICS.md §1.2, parallel form).
 
 use super::lanes::{LaneMath, M3, V3};
@@ -133,17 +134,22 @@ impl<L: LaneMath> StrainLanes<L> {
 pub(crate) fn log_volume<L: LaneMath>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
     let j = L::ONE + s.j1;
     let above = j.simd_gt(L::splat(J_MIN));
-    let l_above = || s.j1 - excess;
-    let l_below = || L::splat(J_MIN.ln()) + (j - L::splat(J_MIN)) / L::splat(J_MIN);
+    // Plain functions, not closures: each arm is compiled into the caller (and its AVX).
     let (l, dl) = match Taken::of(above) {
-        Taken::All => (l_above(), L::ONE / j),
-        Taken::None => (l_below(), L::splat(1.0 / J_MIN)),
+        Taken::All => (s.j1 - excess, L::ONE / j),
+        Taken::None => (log_volume_below(j), L::splat(1.0 / J_MIN)),
         Taken::Some => (
-            above.select(l_above(), l_below()),
+            above.select(s.j1 - excess, log_volume_below(j)),
             above.select(L::ONE / j, L::splat(1.0 / J_MIN)),
         ),
     };
     (l, dl, above)
+}
+
+/// `L(J)` below `J_MIN`: continued linearly.
+#[inline(always)]
+fn log_volume_below<L: LaneMath>(j: L) -> L {
+    L::splat(J_MIN.ln()) + (j - L::splat(J_MIN)) / L::splat(J_MIN)
 }
 
 /// `ψ̂ ≥ 0` and `½ ∂ψ̂/∂F = F − L' cof F` (rest_free.rs `shape_energy`), given
@@ -157,21 +163,43 @@ pub(crate) fn shape_energy<L: LaneMath>(
     cof_f: &M3<L>,
 ) -> (L, M3<L>) {
     let (l, dl, above) = volume;
-    let two = L::splat(2.0);
     let h_norm2 = s.h.norm2();
+    let (psi, grad) = match Taken::of(above) {
+        Taken::All => shape_energy_above(s, h_norm2, excess),
+        Taken::None => shape_energy_below(s, h_norm2, l, dl, cof_f),
+        Taken::Some => {
+            let (psi_a, grad_a) = shape_energy_above(s, h_norm2, excess);
+            let (psi_b, grad_b) = shape_energy_below(s, h_norm2, l, dl, cof_f);
+            (
+                above.select(psi_a, psi_b),
+                select_m3(above, &grad_a, &grad_b),
+            )
+        }
+    };
+    (psi.max(L::ZERO), grad)
+}
+
+/// `ψ̂` (before its clamp at 0) and `½ ∂ψ̂/∂F` above `J_MIN`.
+#[inline(always)]
+fn shape_energy_above<L: LaneMath>(s: &StrainLanes<L>, h_norm2: L, excess: L) -> (L, M3<L>) {
+    let two = L::splat(2.0);
     let j = L::ONE + s.j1;
-    let psi_above = || h_norm2 - two * s.i2 - two * s.det_h + two * excess;
-    let psi_below = || two * s.tr + h_norm2 - two * l;
-    let grad_above = || s.j_f_minus_cof() * (L::ONE / j);
-    let grad_below = || M3::diagonal(L::ONE) + s.h - *cof_f * dl;
-    match Taken::of(above) {
-        Taken::All => (psi_above().max(L::ZERO), grad_above()),
-        Taken::None => (psi_below().max(L::ZERO), grad_below()),
-        Taken::Some => (
-            above.select(psi_above(), psi_below()).max(L::ZERO),
-            select_m3(above, &grad_above(), &grad_below()),
-        ),
-    }
+    let psi = h_norm2 - two * s.i2 - two * s.det_h + two * excess;
+    (psi, s.j_f_minus_cof() * (L::ONE / j))
+}
+
+/// `ψ̂` (before its clamp at 0) and `½ ∂ψ̂/∂F` below `J_MIN`.
+#[inline(always)]
+fn shape_energy_below<L: LaneMath>(
+    s: &StrainLanes<L>,
+    h_norm2: L,
+    l: L,
+    dl: L,
+    cof_f: &M3<L>,
+) -> (L, M3<L>) {
+    let two = L::splat(2.0);
+    let psi = two * s.tr + h_norm2 - two * l;
+    (psi, M3::diagonal(L::ONE) + s.h - *cof_f * dl)
 }
 
 /// `C_D = sqrt(ψ̂)`, `∂C_D/∂F`, and the lanes where `C_D` has a direction
