@@ -1,6 +1,6 @@
-//! One colour's tets projected eight (or sixteen) at a time ([`super::rest_free_lanes`]): load a
-//! [`LaneBlock`]'s terms lane by lane, read its tets' nodes into the lanes, project, write
-//! the live ones back ([`super::lane_nodes`]).
+//! One colour's tets projected eight (or sixteen) at a time
+//! ([`super::rest_free_lanes`]): load a [`LaneBlock`]'s terms lane by lane, read its tets'
+//! nodes into the lanes, project, write the live ones back ([`super::lane_nodes`]).
 
 #[cfg(target_arch = "x86_64")]
 use super::lane_avx::Avx;
@@ -93,8 +93,8 @@ pub(super) enum Simd {
 /// lane value where `simd` allows it and the CPU has AVX-512F, block by block in one AVX
 /// register where it has AVX2 (both checked at run time, so a portable build uses them
 /// too), else with `wide`'s lanes at the build's instruction set. Each tet's bits are
-/// the same on all three. `lambdas`
-/// holds the multipliers of the blocks' slots ([`LaneSlots::slot_range`]).
+/// the same on all three. `lambdas` holds the multipliers of the blocks' slots
+/// ([`LaneSlots::slot_range`]).
 ///
 /// # Safety
 /// As [`project_block`].
@@ -163,9 +163,9 @@ unsafe fn project_run_avx512(
     unsafe { project_run_avx2(blocks, lambdas, nodes, inv_mass) }
 }
 
-/// The run two blocks at a time in [`super::lane_avx512::Avx512`] lanes (the blocks of a run share no node,
-/// so their order does not matter), compiled for AVX-512F; an odd last block in
-/// [`Avx`] lanes.
+/// The run two blocks at a time in [`super::lane_avx512::Avx512`] lanes (the blocks of a
+/// run are of one colour and share no node, so their order does not matter), compiled
+/// for AVX-512F; an odd last block in [`Avx`] lanes.
 ///
 /// # Safety
 /// The CPU must have AVX-512F; otherwise as [`project_block`].

@@ -2,8 +2,8 @@
 //! the same formulas, in the same order, as the scalar reference
 //! ([`super::rest_free`], [`super::strain`], [`super::neo_hookean::apply_pair`]), with each
 //! branch of the reference evaluated where a lane of the block takes it and chosen by a
-//! mask ([`Taken`]). Tets of one colour
-//! share no node, so eight of them are independent (PHYSICS.md §1.2, parallel form).
+//! mask ([`Taken`]). Tets of one colour share no node, so eight of them are independent
+//! (PHYSICS.md §1.2, parallel form).
 
 use super::lanes::{LaneMath, M3, V3};
 use super::rest_free::{J_MIN, MIN_SHAPE};
