@@ -74,9 +74,12 @@ impl RecordedBody {
     /// (`ahead_ms` summed over the frames: the implicit scheme's refactorisation after
     /// releases); `None` for the other models.
     pub fn ahead_ms(&self) -> Option<f64> {
-        let mut frames = self.report.frames.iter().peekable();
-        frames.peek()?;
-        frames
+        if self.report.frames.is_empty() {
+            return None;
+        }
+        self.report
+            .frames
+            .iter()
             .map(|f| match &f.stats {
                 FrameData::Xpbd(s) => Some(s.ahead_ms),
                 FrameData::Edges(_) => None,

@@ -105,8 +105,9 @@ pub(super) unsafe fn project_run(
     inv_mass: &[f32],
     simd: Simd,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    if simd == Simd::Widest && has_avx512() {
+    // The AVX-512 lanes need Rust 1.89 (build.rs); before it the AVX ones serve.
+    #[cfg(all(target_arch = "x86_64", incise_avx512))]
+    if simd == Simd::Widest && std::arch::is_x86_feature_detected!("avx512f") {
         // SAFETY: the CPU has AVX-512F (and so AVX2); the rest is the caller's contract.
         return unsafe { project_run_avx512(blocks, lambdas, nodes, inv_mass) };
     }
@@ -134,33 +135,6 @@ unsafe fn project_run_avx2(
 ) {
     // SAFETY: the caller's contract.
     unsafe { project_blocks::<Avx>(blocks, lambdas, nodes, inv_mass) }
-}
-
-/// Whether the CPU has AVX-512F and this build its lanes (Rust 1.89 and later: build.rs).
-#[cfg(all(target_arch = "x86_64", incise_avx512))]
-fn has_avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-}
-
-/// Whether the CPU has AVX-512F and this build its lanes: not before Rust 1.89.
-#[cfg(all(target_arch = "x86_64", not(incise_avx512)))]
-fn has_avx512() -> bool {
-    false
-}
-
-/// Never called: [`has_avx512`] is false before Rust 1.89.
-///
-/// # Safety
-/// As [`project_run_avx2`].
-#[cfg(all(target_arch = "x86_64", not(incise_avx512)))]
-unsafe fn project_run_avx512(
-    blocks: &[LaneBlock],
-    lambdas: &mut [f32],
-    nodes: &SharedNodes,
-    inv_mass: &[f32],
-) {
-    // SAFETY: the caller's contract.
-    unsafe { project_run_avx2(blocks, lambdas, nodes, inv_mass) }
 }
 
 /// The run two blocks at a time in [`super::lane_avx512::Avx512`] lanes (the blocks of a
@@ -352,10 +326,10 @@ mod tests {
     /// register gives it: the nodes, the multipliers, the dead tets and padding left as
     /// they were; where the CPU has AVX-512F. Broken on purpose once (the pair's
     /// multipliers written to each other's block): fails.
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", incise_avx512))]
     #[test]
     fn avx512_pairs_project_what_avx_blocks_project() {
-        if !has_avx512() {
+        if !std::arch::is_x86_feature_detected!("avx512f") {
             eprintln!("skipping: no AVX-512F");
             return;
         }
