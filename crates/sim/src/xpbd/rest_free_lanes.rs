@@ -31,6 +31,15 @@ pub struct TetLanes<L> {
 /// `log1p_excess`).
 #[inline(always)]
 pub(crate) fn log1p_excess<L: LaneMath>(x: L) -> L {
+    log1p_excess_in(x, false)
+}
+
+/// [`log1p_excess`], by the series alone where `all_series` says every lane takes it.
+#[inline(always)]
+fn log1p_excess_in<L: LaneMath>(x: L, all_series: bool) -> L {
+    if all_series {
+        return log1p_excess_series(x);
+    }
     let series = x.abs().simd_lt(L::splat(SERIES_LIMIT));
     match Taken::of(series) {
         Taken::All => log1p_excess_series(x),
@@ -91,6 +100,8 @@ pub(crate) struct StrainLanes<L> {
     pub(crate) det_h: L,
     /// `J − 1`.
     pub(crate) j1: L,
+    /// `J`.
+    pub(crate) j: L,
     /// `cof H`.
     pub(crate) cof_h: M3<L>,
 }
@@ -103,12 +114,14 @@ impl<L: LaneMath> StrainLanes<L> {
         let tr_h2 = h.mul_mat(&h).trace();
         let i2 = L::splat(0.5) * (tr * tr - tr_h2);
         let det_h = h.determinant();
+        let j1 = tr + i2 + det_h;
         StrainLanes {
             h,
             tr,
             i2,
             det_h,
-            j1: tr + i2 + det_h,
+            j1,
+            j: L::ONE + j1,
             cof_h: h.cofactor(),
         }
     }
@@ -132,10 +145,21 @@ impl<L: LaneMath> StrainLanes<L> {
 // docs/physics-notes.md, rest-free pair, C_H.
 #[inline(always)]
 pub(crate) fn log_volume<L: LaneMath>(s: &StrainLanes<L>, excess: L) -> (L, L, L) {
-    let j = L::ONE + s.j1;
+    log_volume_in(s, excess, false)
+}
+
+/// [`log_volume`], above `J_MIN` alone where `all_above` says every lane is.
+#[inline(always)]
+fn log_volume_in<L: LaneMath>(s: &StrainLanes<L>, excess: L, all_above: bool) -> (L, L, L) {
+    let j = s.j;
     let above = j.simd_gt(L::splat(J_MIN));
+    let taken = if all_above {
+        Taken::All
+    } else {
+        Taken::of(above)
+    };
     // Plain functions, not closures: each arm is compiled into the caller (and its AVX).
-    let (l, dl) = match Taken::of(above) {
+    let (l, dl) = match taken {
         Taken::All => (s.j1 - excess, L::ONE / j),
         Taken::None => (log_volume_below(j), L::splat(1.0 / J_MIN)),
         Taken::Some => (
@@ -162,9 +186,26 @@ pub(crate) fn shape_energy<L: LaneMath>(
     excess: L,
     cof_f: &M3<L>,
 ) -> (L, M3<L>) {
+    shape_energy_in(s, volume, excess, cof_f, false)
+}
+
+/// [`shape_energy`], above `J_MIN` alone where `all_above` says every lane is.
+#[inline(always)]
+fn shape_energy_in<L: LaneMath>(
+    s: &StrainLanes<L>,
+    volume: (L, L, L),
+    excess: L,
+    cof_f: &M3<L>,
+    all_above: bool,
+) -> (L, M3<L>) {
     let (l, dl, above) = volume;
     let h_norm2 = s.h.norm2();
-    let (psi, grad) = match Taken::of(above) {
+    let taken = if all_above {
+        Taken::All
+    } else {
+        Taken::of(above)
+    };
+    let (psi, grad) = match taken {
         Taken::All => shape_energy_above(s, h_norm2, excess),
         Taken::None => shape_energy_below(s, h_norm2, l, dl, cof_f),
         Taken::Some => {
@@ -183,7 +224,7 @@ pub(crate) fn shape_energy<L: LaneMath>(
 #[inline(always)]
 fn shape_energy_above<L: LaneMath>(s: &StrainLanes<L>, h_norm2: L, excess: L) -> (L, M3<L>) {
     let two = L::splat(2.0);
-    let j = L::ONE + s.j1;
+    let j = s.j;
     let psi = h_norm2 - two * s.i2 - two * s.det_h + two * excess;
     (psi, s.j_f_minus_cof() * (L::ONE / j))
 }
@@ -211,8 +252,9 @@ fn shape_constraint<L: LaneMath>(
     volume: (L, L, L),
     excess: L,
     cof_f: &M3<L>,
+    common: bool,
 ) -> (L, M3<L>, L) {
-    let (psi, half) = shape_energy(s, volume, excess, cof_f);
+    let (psi, half) = shape_energy_in(s, volume, excess, cof_f, common);
     let c = psi.sqrt();
     let has = c.simd_ge(L::splat(MIN_SHAPE));
     (c, half * (L::ONE / c), has)
@@ -283,19 +325,36 @@ pub fn project_rest_free_lanes<L: LaneMath>(t: &mut TetLanes<L>) -> L {
         c2: t.u[3] - t.u[0],
     };
     let s = StrainLanes::of(du.mul_mat(&t.dm_inv));
+    // The common block: every lane small-strained (the series, so above J_MIN) with a
+    // volume constraint. Its projection is one straight run of code without the three
+    // branches' joins, which the compiler schedules with fewer values on the stack
+    // (`scripts/lane-instructions.sh`: 180 → 171 instructions a tet). Each lane's
+    // operations are the same either way.
+    let series = s.j1.abs().simd_lt(L::splat(SERIES_LIMIT));
+    let above = s.j.simd_gt(L::splat(J_MIN));
+    if Taken::of(series & above & t.alpha_h.is_finite()) == Taken::All {
+        project_strained(t, &s, true)
+    } else {
+        project_strained(t, &s, false)
+    }
+}
+
+/// The rest of [`project_rest_free_lanes`] once the strain is known; `common`: every lane
+/// takes the series, is above `J_MIN` and has a volume constraint (checked by the caller).
+#[inline(always)]
+fn project_strained<L: LaneMath>(t: &mut TetLanes<L>, s: &StrainLanes<L>, common: bool) -> L {
     let dm_inv_t = t.dm_inv.transpose();
-    let excess = log1p_excess(s.j1);
-    let volume = log_volume(&s, excess);
+    let excess = log1p_excess_in(s.j1, common);
+    let volume = log_volume_in(s, excess, common);
     let (c_h, dl, _) = volume;
     let cof_f = s.cof_f();
-    let (c_d, dcd, has_shape) = shape_constraint(&s, volume, excess, &cof_f);
-    let with_volume = t.alpha_h.is_finite();
-    let (g_h, c_h, alpha_h) = row(
-        with_volume,
-        vertex_gradients(&(cof_f * dl), &dm_inv_t),
-        c_h,
-        t.alpha_h,
-    );
+    let g_h = vertex_gradients(&(cof_f * dl), &dm_inv_t);
+    let (g_h, c_h, alpha_h) = if common {
+        (g_h, c_h, t.alpha_h)
+    } else {
+        row(t.alpha_h.is_finite(), g_h, c_h, t.alpha_h)
+    };
+    let (c_d, dcd, has_shape) = shape_constraint(s, volume, excess, &cof_f, common);
     let (g_d, c_d, alpha_d) = row(has_shape, vertex_gradients(&dcd, &dm_inv_t), c_d, t.alpha_d);
     // apply_pair: scale to O(1), solve, skip lanes with a singular (or NaN) system.
     let a = weighted_dot(&t.w, &g_h, &g_h) + alpha_h;
@@ -371,9 +430,10 @@ mod tests {
     /// and a lane that is not live stays put: with the portable lanes, and with the AVX
     /// ones where the CPU has AVX2. Once with the eight cases side by side (every mask
     /// mixed: both sides of each branch evaluated and selected), then with each case in
-    /// all eight lanes (a branch no lane takes is skipped, `Taken`). Broken on purpose
+    /// all eight lanes (a branch no lane takes is skipped, `Taken`; the small strains with
+    /// a volume constraint take the common block's straight path). Broken on purpose
     /// once each: `row`'s every-lane arm given a unit compliance, `log_volume`'s arms
-    /// given the other side's `L'`: fails.
+    /// given the other side's `L'`, the common block's volume row a unit compliance: fails.
     #[test]
     fn lanes_match_the_scalar_reference() {
         let mixed = |k: usize| (k, k != 5);
