@@ -35,7 +35,6 @@ import collections, json, re, subprocess, sys
 
 binary, profile, bench = sys.argv[1:4]
 KERNEL = "xpbd::lane_pass::project_run"  # the run functions the lane kernel is inlined into
-WARM_UP = 2  # frames the benchmark runs before the one it times
 
 # Executed instructions per address of the kernel (callgrind: `positions: instr line`).
 counts, names, fn, pos, after_call = collections.Counter(), {}, "", 0, False
@@ -70,7 +69,7 @@ if not counts:
 
 run = json.load(open(bench))
 run = run[0] if isinstance(run, list) else run
-projections = run["tets"] * run["substeps"] * (run["frames"] + WARM_UP)
+projections = run["tets"] * run["substeps"] * (run["frames"] + run["warm_up_frames"])
 
 # Each address's opcode and the functions it was inlined from (outermost first).
 lo, hi = min(counts), max(counts) + 16

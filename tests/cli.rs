@@ -282,6 +282,8 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
         "{r}"
     );
     assert_eq!(r["cpu_kernel"], "Lanes", "the default kernel: {r}");
+    // The frames stepped untimed, which scripts/lane-instructions.sh counts in.
+    assert_eq!(r["warm_up_frames"].as_u64(), Some(2), "{r}");
     let f = |k: &str| r[k].as_f64().unwrap();
     assert!(f("substeps_ms_median") > 0.0, "{r}");
     assert!(f("frame_ms_median") >= f("substeps_ms_median"), "{r}");

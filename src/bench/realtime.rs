@@ -41,8 +41,10 @@ pub struct RealtimeResult {
     pub substeps: u32,
     /// Frame length, s.
     pub frame_dt: f32,
-    /// Frames timed (after 2 warm-up frames).
+    /// Frames timed (after the warm-up frames).
     pub frames: usize,
+    /// Frames stepped before the timed ones and not timed ([`WARM_UP_FRAMES`]).
+    pub warm_up_frames: u64,
     /// Median wall ms per frame.
     pub frame_ms_median: f64,
     /// 99th-percentile wall ms per frame.
@@ -69,6 +71,9 @@ pub struct RealtimeResult {
     /// Whether the median frame fits the scene's frame length in wall time.
     pub real_time: bool,
 }
+
+/// Frames each run steps before it starts timing (first-frame allocation, thread start).
+pub const WARM_UP_FRAMES: u64 = 2;
 
 /// CPU threads, projection kernel and sweep order (each by default the scene's).
 pub type CpuChoice = (Option<usize>, Option<CpuKernel>, Option<CpuSweep>);
@@ -304,7 +309,7 @@ fn measure_scheme(
         .with_context(|| format!("{}: placing the body", scene_path.display()))?;
     let (mut frame, mut solve, mut checks, mut stress, mut passes) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for f in 0..frames.max(1) as u64 + 2 {
+    for f in 0..frames.max(1) as u64 + WARM_UP_FRAMES {
         if let Some(s) = &stroke {
             body.move_tool(s.pose_at((f + 1) as f64 * frame_dt as f64));
         }
@@ -312,7 +317,7 @@ fn measure_scheme(
         let st = body
             .step_frame()
             .with_context(|| format!("{}: frame {f}", scene_path.display()))?;
-        if f >= 2 {
+        if f >= WARM_UP_FRAMES {
             frame.push(t.elapsed().as_secs_f64() * 1e3);
             solve.push(st.solve_ms - st.check_ms);
             checks.push(st.check_ms);
@@ -350,6 +355,7 @@ fn measure_scheme(
         substeps,
         frame_dt,
         frames: frame.len(),
+        warm_up_frames: WARM_UP_FRAMES,
         frame_ms_median,
         frame_ms_p99: percentile(&frame, 0.99),
         substeps_ms_median: median(&solve),
