@@ -29,7 +29,11 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 valgrind --tool=callgrind --dump-instr=yes --callgrind-out-file="$work/cg.out" \
     "$bin" bench realtime --scene config/intestine_pull_xpbd.ron --cpu-kernel "$kernel" \
-    --cpu-sweep "$sweep" --threads 1 --frames 1 --json >"$work/bench.json" 2>"$work/valgrind.log"
+    --cpu-sweep "$sweep" --threads 1 --frames 1 --json >"$work/bench.json" 2>"$work/valgrind.log" || {
+    tail -n 20 "$work/valgrind.log" >&2
+    echo "lane-instructions: the benchmark failed under valgrind (its output above)" >&2
+    exit 1
+}
 python3 - "$bin" "$work/cg.out" "$work/bench.json" <<'EOF'
 import collections, json, re, subprocess, sys
 
