@@ -37,11 +37,8 @@ pub(crate) fn log1p_excess<L: LaneMath>(x: L) -> L {
 /// [`log1p_excess`], by the series alone where `all_series` says every lane takes it.
 #[inline(always)]
 fn log1p_excess_in<L: LaneMath>(x: L, all_series: bool) -> L {
-    if all_series {
-        return log1p_excess_series(x);
-    }
     let series = x.abs().simd_lt(L::splat(SERIES_LIMIT));
-    match Taken::of(series) {
+    match Taken::given(all_series, series) {
         Taken::All => log1p_excess_series(x),
         Taken::None => log1p_excess_direct(x),
         Taken::Some => series.select(log1p_excess_series(x), log1p_excess_direct(x)),
@@ -84,6 +81,17 @@ impl Taken {
             0 => Taken::None,
             b if b == L::ALL => Taken::All,
             _ => Taken::Some,
+        }
+    }
+
+    /// [`Taken::All`] where the caller knows every lane sets `mask` (the common block:
+    /// the mask is then not looked at), else the lanes `mask` sets.
+    #[inline(always)]
+    pub(crate) fn given<L: LaneMath>(known_all: bool, mask: L) -> Taken {
+        if known_all {
+            Taken::All
+        } else {
+            Taken::of(mask)
         }
     }
 }
@@ -153,13 +161,8 @@ pub(crate) fn log_volume<L: LaneMath>(s: &StrainLanes<L>, excess: L) -> (L, L, L
 fn log_volume_in<L: LaneMath>(s: &StrainLanes<L>, excess: L, all_above: bool) -> (L, L, L) {
     let j = s.j;
     let above = j.simd_gt(L::splat(J_MIN));
-    let taken = if all_above {
-        Taken::All
-    } else {
-        Taken::of(above)
-    };
     // Plain functions, not closures: each arm is compiled into the caller (and its AVX).
-    let (l, dl) = match taken {
+    let (l, dl) = match Taken::given(all_above, above) {
         Taken::All => (s.j1 - excess, L::ONE / j),
         Taken::None => (log_volume_below(j), L::splat(1.0 / J_MIN)),
         Taken::Some => (
@@ -200,12 +203,7 @@ fn shape_energy_in<L: LaneMath>(
 ) -> (L, M3<L>) {
     let (l, dl, above) = volume;
     let h_norm2 = s.h.norm2();
-    let taken = if all_above {
-        Taken::All
-    } else {
-        Taken::of(above)
-    };
-    let (psi, grad) = match taken {
+    let (psi, grad) = match Taken::given(all_above, above) {
         Taken::All => shape_energy_above(s, h_norm2, excess),
         Taken::None => shape_energy_below(s, h_norm2, l, dl, cof_f),
         Taken::Some => {
@@ -294,10 +292,11 @@ fn weighted_dot<L: LaneMath>(w: &[L; 4], a: &[V3<L>; 4], b: &[V3<L>; 4]) -> L {
 }
 
 /// One row of the 2×2 system, or an empty row (zero gradient and value, unit compliance)
-/// where its constraint does not apply.
+/// where its constraint does not apply (`on` clear); `all_on`: the caller knows it applies
+/// in every lane.
 #[inline(always)]
-fn row<L: LaneMath>(on: L, g: [V3<L>; 4], c: L, alpha: L) -> ([V3<L>; 4], L, L) {
-    if Taken::of(on) == Taken::All {
+fn row<L: LaneMath>(all_on: bool, on: L, g: [V3<L>; 4], c: L, alpha: L) -> ([V3<L>; 4], L, L) {
+    if Taken::given(all_on, on) == Taken::All {
         return (g, c, alpha);
     }
     (
@@ -348,14 +347,21 @@ fn project_strained<L: LaneMath>(t: &mut TetLanes<L>, s: &StrainLanes<L>, common
     let volume = log_volume_in(s, excess, common);
     let (c_h, dl, _) = volume;
     let cof_f = s.cof_f();
-    let g_h = vertex_gradients(&(cof_f * dl), &dm_inv_t);
-    let (g_h, c_h, alpha_h) = if common {
-        (g_h, c_h, t.alpha_h)
-    } else {
-        row(t.alpha_h.is_finite(), g_h, c_h, t.alpha_h)
-    };
+    let (g_h, c_h, alpha_h) = row(
+        common,
+        t.alpha_h.is_finite(),
+        vertex_gradients(&(cof_f * dl), &dm_inv_t),
+        c_h,
+        t.alpha_h,
+    );
     let (c_d, dcd, has_shape) = shape_constraint(s, volume, excess, &cof_f, common);
-    let (g_d, c_d, alpha_d) = row(has_shape, vertex_gradients(&dcd, &dm_inv_t), c_d, t.alpha_d);
+    let (g_d, c_d, alpha_d) = row(
+        false,
+        has_shape,
+        vertex_gradients(&dcd, &dm_inv_t),
+        c_d,
+        t.alpha_d,
+    );
     // apply_pair: scale to O(1), solve, skip lanes with a singular (or NaN) system.
     let a = weighted_dot(&t.w, &g_h, &g_h) + alpha_h;
     let b = weighted_dot(&t.w, &g_h, &g_d);
