@@ -26,8 +26,9 @@ pub struct RealtimeResult {
     pub scene: String,
     /// "cpu (N threads)" or the GPU adapter.
     pub device: String,
-    /// The CPU projection kernel ("Lanes", "Avx2Lanes", "PortableLanes" or "Scalar"; the GPU ignores
-    /// it), with ", Blocks" for the partitioned sweep; "Newton" for the implicit scheme.
+    /// The CPU projection kernel ("Lanes", "Avx2Lanes", "PortableLanes" or "Scalar"; the
+    /// GPU ignores it), with ", Blocks" for the partitioned sweep; "Newton" for the
+    /// implicit scheme.
     pub cpu_kernel: String,
     /// The time integrator: "XPBD" or "Newton".
     pub scheme: String,

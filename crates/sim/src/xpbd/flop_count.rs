@@ -173,8 +173,8 @@ mod tests {
     use super::*;
 
     /// The count is what the projection does: about five hundred and fifty flops (547 when
-    /// written), the same every call, and it moves when the projection's arithmetic changes (broken
-    /// on purpose once: `Mul` not tallied -> the count left the range).
+    /// written), the same every call, and it moves when the projection's arithmetic
+    /// changes (broken on purpose once: `Mul` not tallied -> the count left the range).
     #[test]
     fn a_projection_counts_a_few_hundred_flops_every_time() {
         let n = projection_flops();

@@ -69,7 +69,8 @@ unsafe fn finish_block<L: NodeLanes>(
     unsafe { L::store_nodes(b, u, nodes) };
     let dl_h = dl_h.to_array();
     let first = b.first as usize - base;
-    if b.count as usize == LANES && (0..LANES).all(|k| b.is_live(k)) {
+    // Every lane live (padding lanes never are, so a full block).
+    if L::new(b.live).bits() == L::ALL {
         lambdas[first..first + LANES].copy_from_slice(&dl_h);
         return;
     }
