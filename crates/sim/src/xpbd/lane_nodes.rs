@@ -1,13 +1,17 @@
 //! Node values into and out of the lanes (issue 35, item 3): an XPBD block's four nodes'
-//! displacements and inverse masses of eight tets read into lane registers before the
-//! projection and the displacements written back after it; and any eight nodes of a slice
-//! read by index (`read_vec3s`: the implicit scheme's tet evaluation and product).
+//! displacements and inverse masses of eight tets read from the sweep's node records
+//! ([`NodeRecord`]) into lane registers before the projection and the displacements
+//! written back after it; and any eight nodes of a slice read by index (`read_vec3s`: the
+//! implicit scheme's tet evaluation and product).
 //!
 //! The generic way reads lane by lane into arrays and loads those; the AVX one reads each
-//! node's `x, y` as one 8-byte load and `z` as one 4-byte load and transposes in registers
-//! (no store of eight scalars followed by one wide load, which the CPU cannot forward, and
-//! no branch per lane), then writes back through two unpacks. Both give every lane the
-//! same bits, so the projection's results do not depend on which runs.
+//! node's record with one 16-byte load, two records to a register, and transposes four
+//! such registers into `x, y, z, w` (no store of eight scalars followed by one wide load,
+//! which the CPU cannot forward, and no branch per lane); it writes back by the same
+//! transpose, whole records with the inverse mass each lane read. From a slice of
+//! `Vec3` it reads `x, y` with one 8-byte load and `z` with one 4-byte load. Both ways
+//! give every lane the same bits, so the projection's results do not depend on which
+//! runs.
 //!
 //! Every lane of a block is read, padding included: a padding lane names its block's first
 //! tet's nodes ([`LaneBlock`]), which belong to this block alone within its colour, as a
@@ -18,6 +22,7 @@ use glam::Vec3;
 
 use super::lane_slots::LaneBlock;
 use super::lanes::{LANES, Lane, V3};
+use super::node_records::NodeRecord;
 use super::shared_nodes::SharedNodes;
 
 /// A lane type's way of reading and writing a block's nodes.
@@ -41,19 +46,13 @@ pub(crate) trait NodeLanes: Lane {
     /// # Safety
     /// No other thread may write these nodes during the call (colouring).
     #[inline(always)]
-    unsafe fn load_nodes(
-        b: &LaneBlock,
-        nodes: &SharedNodes,
-        inv_mass: &[f32],
-    ) -> ([V3<Self>; 4], [Self; 4]) {
+    unsafe fn load_nodes(b: &LaneBlock, nodes: &SharedNodes) -> ([V3<Self>; 4], [Self; 4]) {
         let mut u = [[Vec3::ZERO; LANES]; 4];
         let mut w = [[0.0f32; LANES]; 4];
         for k in (0..LANES).filter(|&k| b.is_live(k)) {
             for j in 0..4 {
-                let i = b.nodes[j][k];
                 // SAFETY: the caller's contract.
-                u[j][k] = unsafe { nodes.get(i) };
-                w[j][k] = inv_mass[i as usize];
+                (u[j][k], w[j][k]) = unsafe { nodes.get(b.nodes[j][k]) };
             }
         }
         // Written out, not `map`: an out-of-line `map` would be compiled without the
@@ -74,12 +73,14 @@ pub(crate) trait NodeLanes: Lane {
         )
     }
 
-    /// Write lane k of `u[j]` to node j of lane k's tet, for each live lane k.
+    /// Write lane k of `u[j]` to node j of lane k's tet, for each live lane k; `w` is what
+    /// [`NodeLanes::load_nodes`] read (a way that writes whole records writes it back).
     ///
     /// # Safety
     /// No other thread may read or write these nodes during the call (colouring).
     #[inline(always)]
-    unsafe fn store_nodes(b: &LaneBlock, u: &[V3<Self>; 4], nodes: &SharedNodes) {
+    unsafe fn store_nodes(b: &LaneBlock, u: &[V3<Self>; 4], w: &[Self; 4], nodes: &SharedNodes) {
+        let _ = w;
         // Each position stored once, then read lane by lane.
         let u = [
             u[0].to_arrays(),
@@ -169,25 +170,65 @@ mod avx {
         }
     }
 
-    /// One node row of the block: displacements and inverse masses, zero where `live` is
-    /// clear.
+    /// One node row of the block: the records of the eight lanes' nodes, transposed into
+    /// displacements and inverse masses (lanes 0–3 in the low half, 4–7 in the high),
+    /// zero where `live` is clear.
     ///
     /// # Safety
-    /// As [`positions`]; `inv_mass` holds every index.
+    /// Every index is a record of `base`'s array; AVX2 is present.
     #[inline(always)]
-    unsafe fn read_node(
-        base: *const f32,
-        inv_mass: &[f32],
-        idx: &[u32; LANES],
-        live: Avx,
-    ) -> (V3<Avx>, Avx) {
+    unsafe fn read_node(base: *const NodeRecord, idx: &[u32; LANES], live: Avx) -> (V3<Avx>, Avx) {
         // SAFETY: the caller's contract.
-        let ([x, y, z], w) =
-            unsafe { (positions(base, idx), scalars(inv_mass.as_ptr(), idx, 1, 0)) };
-        let x = Avx::from_raw(x) & live;
-        let y = Avx::from_raw(y) & live;
-        let z = Avx::from_raw(z) & live;
-        (V3 { x, y, z }, Avx::from_raw(w) & live)
+        let [x, y, z, w] = unsafe {
+            transpose(
+                records(base, idx, 0),
+                records(base, idx, 1),
+                records(base, idx, 2),
+                records(base, idx, 3),
+            )
+        };
+        let [x, y, z, w] = [x, y, z, w].map(Avx::from_raw);
+        (
+            V3 {
+                x: x & live,
+                y: y & live,
+                z: z & live,
+            },
+            w & live,
+        )
+    }
+
+    /// The records of lanes `k` (low half) and `k + 4` (high half).
+    ///
+    /// # Safety
+    /// As [`read_node`].
+    #[inline(always)]
+    unsafe fn records(base: *const NodeRecord, idx: &[u32; LANES], k: usize) -> __m256 {
+        // SAFETY: the caller's contract; a record is 16 bytes, 16-aligned.
+        unsafe {
+            let at = |k: usize| base.add(idx[k] as usize) as *const f32;
+            let lo = _mm256_castps128_ps256(_mm_load_ps(at(k)));
+            _mm256_insertf128_ps::<1>(lo, _mm_load_ps(at(k + 4)))
+        }
+    }
+
+    /// Four rows of four values in each half, as four columns (and back: the transpose is
+    /// its own inverse).
+    #[inline(always)]
+    fn transpose(r0: __m256, r1: __m256, r2: __m256, r3: __m256) -> [__m256; 4] {
+        // SAFETY: AVX is present (every caller is compiled with it).
+        unsafe {
+            let t0 = _mm256_unpacklo_ps(r0, r1);
+            let t1 = _mm256_unpackhi_ps(r0, r1);
+            let t2 = _mm256_unpacklo_ps(r2, r3);
+            let t3 = _mm256_unpackhi_ps(r2, r3);
+            [
+                _mm256_shuffle_ps::<0x44>(t0, t2),
+                _mm256_shuffle_ps::<0xEE>(t0, t2),
+                _mm256_shuffle_ps::<0x44>(t1, t3),
+                _mm256_shuffle_ps::<0xEE>(t1, t3),
+            ]
+        }
     }
 
     /// Whether every index of the rows is below `len`.
@@ -228,30 +269,26 @@ mod avx {
         }
 
         #[inline(always)]
-        unsafe fn load_nodes(
-            b: &LaneBlock,
-            nodes: &SharedNodes,
-            inv_mass: &[f32],
-        ) -> ([V3<Avx>; 4], [Avx; 4]) {
+        unsafe fn load_nodes(b: &LaneBlock, nodes: &SharedNodes) -> ([V3<Avx>; 4], [Avx; 4]) {
             assert!(
-                rows_below(&b.nodes, nodes.len().min(inv_mass.len())),
+                rows_below(&b.nodes, nodes.len()),
                 "a lane block names a node past the mesh's"
             );
-            let base = nodes.as_ptr() as *const f32;
+            let base = nodes.as_ptr() as *const NodeRecord;
             let live = Avx::new(b.live);
             // SAFETY: every index is in bounds (checked); AVX2 is present; the nodes are
             // this thread's (the caller's contract).
             unsafe {
-                let r0 = read_node(base, inv_mass, &b.nodes[0], live);
-                let r1 = read_node(base, inv_mass, &b.nodes[1], live);
-                let r2 = read_node(base, inv_mass, &b.nodes[2], live);
-                let r3 = read_node(base, inv_mass, &b.nodes[3], live);
+                let r0 = read_node(base, &b.nodes[0], live);
+                let r1 = read_node(base, &b.nodes[1], live);
+                let r2 = read_node(base, &b.nodes[2], live);
+                let r3 = read_node(base, &b.nodes[3], live);
                 ([r0.0, r1.0, r2.0, r3.0], [r0.1, r1.1, r2.1, r3.1])
             }
         }
 
         #[inline(always)]
-        unsafe fn store_nodes(b: &LaneBlock, u: &[V3<Avx>; 4], nodes: &SharedNodes) {
+        unsafe fn store_nodes(b: &LaneBlock, u: &[V3<Avx>; 4], w: &[Avx; 4], nodes: &SharedNodes) {
             assert!(
                 rows_below(&b.nodes, nodes.len()),
                 "a lane block names a node past the mesh's"
@@ -260,26 +297,28 @@ mod avx {
             // SAFETY: in bounds (checked); AVX2 is present; the nodes are this thread's.
             unsafe {
                 let live = _mm256_movemask_ps(Avx::new(b.live).raw());
-                for (j, u) in u.iter().enumerate() {
-                    let (x, y) = (u.x.raw(), u.y.raw());
-                    // [x0 y0 x1 y1 | x4 y4 x5 y5] and [x2 y2 x3 y3 | x6 y6 x7 y7], as pairs.
-                    let lo: [i64; 4] = std::mem::transmute(_mm256_unpacklo_ps(x, y));
-                    let hi: [i64; 4] = std::mem::transmute(_mm256_unpackhi_ps(x, y));
-                    let xy = [lo[0], lo[1], hi[0], hi[1], lo[2], lo[3], hi[2], hi[3]];
-                    let z = u.z.to_array();
+                for j in 0..4 {
+                    let u = &u[j];
+                    // Each live lane's record whole: its displacement and the inverse
+                    // mass it was read with (a live lane's, unmasked).
+                    let [r0, r1, r2, r3] = transpose(u.x.raw(), u.y.raw(), u.z.raw(), w[j].raw());
+                    let halves = [r0, r1, r2, r3];
+                    let at = |k: usize| base.add(4 * b.nodes[j][k] as usize);
                     if live == 0xFF {
                         // Every lane live (the common block): no test per lane.
-                        for k in 0..LANES {
-                            let p = base.add(3 * b.nodes[j][k] as usize);
-                            (p as *mut i64).write_unaligned(xy[k]);
-                            p.add(2).write(z[k]);
+                        for (k, r) in halves.iter().enumerate() {
+                            _mm_store_ps(at(k), _mm256_castps256_ps128(*r));
+                            _mm_store_ps(at(k + 4), _mm256_extractf128_ps::<1>(*r));
                         }
                         continue;
                     }
-                    for k in (0..LANES).filter(|&k| live & (1 << k) != 0) {
-                        let p = base.add(3 * b.nodes[j][k] as usize);
-                        (p as *mut i64).write_unaligned(xy[k]);
-                        p.add(2).write(z[k]);
+                    for (k, r) in halves.iter().enumerate() {
+                        if live & (1 << k) != 0 {
+                            _mm_store_ps(at(k), _mm256_castps256_ps128(*r));
+                        }
+                        if live & (1 << (k + 4)) != 0 {
+                            _mm_store_ps(at(k + 4), _mm256_extractf128_ps::<1>(*r));
+                        }
                     }
                 }
             }
@@ -294,6 +333,7 @@ mod tests {
     use super::*;
     use crate::xpbd::lane_slots::LaneSlots;
     use crate::xpbd::neo_hookean::TetTerms;
+    use crate::xpbd::node_records::NodeRecord;
     use crate::xpbd::tet_slot::TetSlot;
 
     /// Nineteen tets on disjoint nodes (three blocks: one with a dead tet, one all live,
@@ -324,22 +364,27 @@ mod tests {
     }
 
     /// What a round trip read and left: the bits of every lane read (displacements, then
-    /// inverse masses, block by block) and of the nodes after.
+    /// inverse masses, block by block) and of the records after (displacement, then
+    /// inverse mass).
     struct RoundTrip {
         read: Vec<u32>,
-        nodes: Vec<[u32; 3]>,
+        nodes: Vec<[u32; 4]>,
     }
 
     /// Read every block, move each lane by its own offset, write it back.
     fn round_trip<L: NodeLanes>() -> RoundTrip {
         let slots = blocks();
-        let mut x: Vec<Vec3> = (0..80).map(|i| node(i).0).collect();
-        let w: Vec<f32> = (0..80).map(|i| node(i).1).collect();
-        let shared = SharedNodes::new(&mut x);
+        let mut records: Vec<NodeRecord> = (0..80)
+            .map(|i| NodeRecord {
+                u: node(i).0,
+                w: node(i).1,
+            })
+            .collect();
+        let shared = SharedNodes::new(&mut records);
         let mut read = Vec::new();
         for b in &slots.blocks {
             // SAFETY: one thread.
-            let (u, m) = unsafe { L::load_nodes(b, &shared, &w) };
+            let (u, m) = unsafe { L::load_nodes(b, &shared) };
             for u in &u {
                 read.extend(u.to_arrays().iter().flatten().map(|f| f.to_bits()));
             }
@@ -353,22 +398,28 @@ mod tests {
                 z: u.z * L::splat(2.0),
             });
             // SAFETY: one thread.
-            unsafe { L::store_nodes(b, &moved, &shared) };
+            unsafe { L::store_nodes(b, &moved, &m, &shared) };
         }
-        let nodes = x.iter().map(|p| p.to_array().map(f32::to_bits)).collect();
+        let nodes = records
+            .iter()
+            .map(|r| r.u.extend(r.w).to_array().map(f32::to_bits))
+            .collect();
         RoundTrip { read, nodes }
     }
 
     /// The AVX way reads the same bits into every lane as the generic one (zero where a
     /// lane is not live), and writes the live lanes' nodes alone: the dead tets' and the
-    /// padding lanes' (which name the block's first tet's nodes) stay as they were.
+    /// padding lanes' (which name the block's first tet's nodes) stay as they were, and
+    /// every inverse mass is the one read (the AVX way writes whole records). Broken on
+    /// purpose once (the AVX way writing the masked mass back): fails.
     #[test]
     fn avx_reads_and_writes_what_the_generic_way_does() {
         let generic = round_trip::<wide::f32x8>();
         for s in 0..19usize {
             for j in 0..4 {
                 let i = 4 * s + j;
-                let at_rest = node(i).0.to_array().map(f32::to_bits);
+                let at_rest = node(i).0.extend(node(i).1).to_array().map(f32::to_bits);
+                assert_eq!(generic.nodes[i][3], at_rest[3], "node {i}'s mass changed");
                 if s == 2 || s == 17 {
                     assert_eq!(generic.nodes[i], at_rest, "dead tet {s} node {i} written");
                 } else {

@@ -21,13 +21,12 @@ unsafe fn project_block<L: NodeLanes>(
     lambdas: &mut [f32],
     base: usize,
     nodes: &SharedNodes,
-    inv_mass: &[f32],
 ) {
     // SAFETY: the caller's contract.
-    let mut lanes = unsafe { block_lanes::<L>(b, nodes, inv_mass) };
+    let mut lanes = unsafe { block_lanes::<L>(b, nodes) };
     let dl_h = project_rest_free_lanes(&mut lanes);
     // SAFETY: the caller's contract.
-    unsafe { finish_block(b, &lanes.u, dl_h, lambdas, base, nodes) };
+    unsafe { finish_block(b, (&lanes.u, &lanes.w), dl_h, lambdas, base, nodes) };
 }
 
 /// The block's tets in lanes: their terms and their nodes' values.
@@ -35,13 +34,9 @@ unsafe fn project_block<L: NodeLanes>(
 /// # Safety
 /// As [`project_block`].
 #[inline(always)]
-unsafe fn block_lanes<L: NodeLanes>(
-    b: &LaneBlock,
-    nodes: &SharedNodes,
-    inv_mass: &[f32],
-) -> TetLanes<L> {
+unsafe fn block_lanes<L: NodeLanes>(b: &LaneBlock, nodes: &SharedNodes) -> TetLanes<L> {
     // SAFETY: the caller's contract.
-    let (u, w) = unsafe { L::load_nodes(b, nodes, inv_mass) };
+    let (u, w) = unsafe { L::load_nodes(b, nodes) };
     TetLanes {
         u,
         w,
@@ -52,21 +47,22 @@ unsafe fn block_lanes<L: NodeLanes>(
     }
 }
 
-/// Write the block's projected displacements `u` and multipliers `dl_h` (live lanes only).
+/// Write the block's projected displacements `u` (beside the inverse masses `w` it read)
+/// and multipliers `dl_h` (live lanes only).
 ///
 /// # Safety
 /// As [`project_block`].
 #[inline(always)]
 unsafe fn finish_block<L: NodeLanes>(
     b: &LaneBlock,
-    u: &[V3<L>; 4],
+    (u, w): (&[V3<L>; 4], &[L; 4]),
     dl_h: L,
     lambdas: &mut [f32],
     base: usize,
     nodes: &SharedNodes,
 ) {
     // SAFETY: the caller's contract.
-    unsafe { L::store_nodes(b, u, nodes) };
+    unsafe { L::store_nodes(b, u, w, nodes) };
     let dl_h = dl_h.to_array();
     let first = b.first as usize - base;
     // Every lane live (padding lanes never are, so a full block).
@@ -103,23 +99,22 @@ pub(super) unsafe fn project_run(
     blocks: &[LaneBlock],
     lambdas: &mut [f32],
     nodes: &SharedNodes,
-    inv_mass: &[f32],
     simd: Simd,
 ) {
     // The AVX-512 lanes need Rust 1.89 (build.rs); before it the AVX ones serve.
     #[cfg(all(target_arch = "x86_64", incise_avx512))]
     if simd == Simd::Widest && std::arch::is_x86_feature_detected!("avx512f") {
         // SAFETY: the CPU has AVX-512F (and so AVX2); the rest is the caller's contract.
-        return unsafe { project_run_avx512(blocks, lambdas, nodes, inv_mass) };
+        return unsafe { project_run_avx512(blocks, lambdas, nodes) };
     }
     #[cfg(target_arch = "x86_64")]
     if simd != Simd::Build && std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2; the rest is the caller's contract.
-        return unsafe { project_run_avx2(blocks, lambdas, nodes, inv_mass) };
+        return unsafe { project_run_avx2(blocks, lambdas, nodes) };
     }
     let _ = simd;
     // SAFETY: the caller's contract.
-    unsafe { project_blocks::<wide::f32x8>(blocks, lambdas, nodes, inv_mass) }
+    unsafe { project_blocks::<wide::f32x8>(blocks, lambdas, nodes) }
 }
 
 /// [`project_blocks`] with [`super::lane_avx::Avx`] lanes, compiled for AVX2.
@@ -128,14 +123,9 @@ pub(super) unsafe fn project_run(
 /// The CPU must have AVX2; otherwise as [`project_block`].
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2")]
-unsafe fn project_run_avx2(
-    blocks: &[LaneBlock],
-    lambdas: &mut [f32],
-    nodes: &SharedNodes,
-    inv_mass: &[f32],
-) {
+unsafe fn project_run_avx2(blocks: &[LaneBlock], lambdas: &mut [f32], nodes: &SharedNodes) {
     // SAFETY: the caller's contract.
-    unsafe { project_blocks::<Avx>(blocks, lambdas, nodes, inv_mass) }
+    unsafe { project_blocks::<Avx>(blocks, lambdas, nodes) }
 }
 
 /// The run two blocks at a time in [`super::lane_avx512::Avx512`] lanes (the blocks of a
@@ -147,12 +137,7 @@ unsafe fn project_run_avx2(
 #[cfg(all(target_arch = "x86_64", incise_avx512))]
 #[allow(clippy::incompatible_msrv)]
 #[target_feature(enable = "avx,avx2,avx512f")]
-unsafe fn project_run_avx512(
-    blocks: &[LaneBlock],
-    lambdas: &mut [f32],
-    nodes: &SharedNodes,
-    inv_mass: &[f32],
-) {
+unsafe fn project_run_avx512(blocks: &[LaneBlock], lambdas: &mut [f32], nodes: &SharedNodes) {
     use super::lane_avx512::{join_tets, split_displacements};
     let base = LaneSlots::slot_range(blocks).start;
     let mut pairs = blocks.chunks_exact(2);
@@ -160,18 +145,18 @@ unsafe fn project_run_avx512(
         let (lo, hi) = (&pair[0], &pair[1]);
         // SAFETY: the caller's contract (the blocks are of one colour: no node in both).
         unsafe {
-            let a = block_lanes::<Avx>(lo, nodes, inv_mass);
-            let b = block_lanes::<Avx>(hi, nodes, inv_mass);
+            let a = block_lanes::<Avx>(lo, nodes);
+            let b = block_lanes::<Avx>(hi, nodes);
             let mut lanes = join_tets(&a, &b);
             let (dl_lo, dl_hi) = project_rest_free_lanes(&mut lanes).split();
             let (u_lo, u_hi) = split_displacements(&lanes.u);
-            finish_block(lo, &u_lo, dl_lo, lambdas, base, nodes);
-            finish_block(hi, &u_hi, dl_hi, lambdas, base, nodes);
+            finish_block(lo, (&u_lo, &a.w), dl_lo, lambdas, base, nodes);
+            finish_block(hi, (&u_hi, &b.w), dl_hi, lambdas, base, nodes);
         }
     }
     for b in pairs.remainder() {
         // SAFETY: the caller's contract.
-        unsafe { project_block::<Avx>(b, lambdas, base, nodes, inv_mass) };
+        unsafe { project_block::<Avx>(b, lambdas, base, nodes) };
     }
 }
 
@@ -184,12 +169,11 @@ unsafe fn project_blocks<L: NodeLanes>(
     blocks: &[LaneBlock],
     lambdas: &mut [f32],
     nodes: &SharedNodes,
-    inv_mass: &[f32],
 ) {
     let base = LaneSlots::slot_range(blocks).start;
     for b in blocks {
         // SAFETY: the caller's contract.
-        unsafe { project_block::<L>(b, lambdas, base, nodes, inv_mass) };
+        unsafe { project_block::<L>(b, lambdas, base, nodes) };
     }
 }
 
@@ -199,6 +183,7 @@ mod tests {
 
     use super::*;
     use crate::xpbd::neo_hookean::{TetProjection, TetTerms};
+    use crate::xpbd::node_records::NodeRecord;
     use crate::xpbd::rest_free::project_rest_free;
     use crate::xpbd::tet_slot::TetSlot;
 
@@ -251,16 +236,30 @@ mod tests {
 
     /// The bits of every node and multiplier after `project` ran the whole run.
     fn run(
-        project: unsafe fn(&[LaneBlock], &mut [f32], &SharedNodes, &[f32]),
+        project: unsafe fn(&[LaneBlock], &mut [f32], &SharedNodes),
     ) -> (Vec<[u32; 3]>, Vec<u32>) {
         let slots = slots();
-        let mut x: Vec<Vec3> = (0..4 * 37).map(displacement).collect();
-        let w: Vec<f32> = (0..4 * 37).map(inv_mass).collect();
+        let mut records: Vec<NodeRecord> = (0..4 * 37)
+            .map(|i| NodeRecord {
+                u: displacement(i),
+                w: inv_mass(i),
+            })
+            .collect();
         let mut lambdas = vec![-1.0f32; LaneSlots::slot_range(&slots.blocks).len()];
-        let shared = SharedNodes::new(&mut x);
+        let shared = SharedNodes::new(&mut records);
         // SAFETY: one thread; the run is one colour (disjoint nodes).
-        unsafe { project(&slots.blocks, &mut lambdas, &shared, &w) };
-        let nodes = x.iter().map(|p| p.to_array().map(f32::to_bits)).collect();
+        unsafe { project(&slots.blocks, &mut lambdas, &shared) };
+        for (i, r) in records.iter().enumerate() {
+            assert_eq!(
+                r.w.to_bits(),
+                inv_mass(i).to_bits(),
+                "node {i}'s mass written"
+            );
+        }
+        let nodes = records
+            .iter()
+            .map(|r| r.u.to_array().map(f32::to_bits))
+            .collect();
         (nodes, lambdas.iter().map(|l| l.to_bits()).collect())
     }
 
@@ -284,7 +283,7 @@ mod tests {
     /// `project`'s run against the scalar reference: nodes within 2e-6 (the lanes' `ln`
     /// rounds apart), multipliers within 2e-6 relative, the dead tets' left as they were.
     fn check_against_reference(
-        project: unsafe fn(&[LaneBlock], &mut [f32], &SharedNodes, &[f32]),
+        project: unsafe fn(&[LaneBlock], &mut [f32], &SharedNodes),
         what: &str,
     ) {
         let (nodes, lambdas) = run(project);
@@ -312,9 +311,9 @@ mod tests {
     /// once (that slice written with two lanes swapped): fails.
     #[test]
     fn lane_runs_project_what_the_scalar_reference_projects() {
-        unsafe fn portable(b: &[LaneBlock], l: &mut [f32], n: &SharedNodes, w: &[f32]) {
+        unsafe fn portable(b: &[LaneBlock], l: &mut [f32], n: &SharedNodes) {
             // SAFETY: the caller's contract.
-            unsafe { project_blocks::<wide::f32x8>(b, l, n, w) }
+            unsafe { project_blocks::<wide::f32x8>(b, l, n) }
         }
         check_against_reference(portable, "wide");
         #[cfg(target_arch = "x86_64")]

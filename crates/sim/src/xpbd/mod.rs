@@ -18,6 +18,7 @@ mod lane_slots;
 pub(crate) mod lanes;
 mod locality;
 mod neo_hookean;
+mod node_records;
 mod params;
 mod release_schedule;
 mod rest_free;

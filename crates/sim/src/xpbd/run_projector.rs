@@ -37,7 +37,6 @@ impl SharedLambdas {
 
 /// Projects spans of tets with the solver's kernel and constraint pair.
 pub(crate) struct RunProjector<'a> {
-    inv_mass: &'a [f32],
     slots: &'a [TetSlot],
     /// The packed blocks, and the widest instructions to look for, when the lanes project.
     lanes: Option<(&'a LaneSlots, Simd)>,
@@ -63,14 +62,8 @@ impl<'a> RunProjector<'a> {
 
     /// The projector of `params`' kernel and pair over `slots`, eight tets at a time in
     /// SIMD lanes from `packed` where the kernel is the lanes', or one by one.
-    pub fn of(
-        params: &SolverParams,
-        inv_mass: &'a [f32],
-        slots: &'a [TetSlot],
-        packed: Option<&'a LaneSlots>,
-    ) -> Self {
+    pub fn of(params: &SolverParams, slots: &'a [TetSlot], packed: Option<&'a LaneSlots>) -> Self {
         RunProjector {
-            inv_mass,
             slots,
             lanes: packed.zip(Self::lane_kernel(params)),
             mode: params.projection,
@@ -100,7 +93,7 @@ impl<'a> RunProjector<'a> {
             // whose slots are their own; the rest is the caller's contract.
             unsafe {
                 let l = lambdas.run(LaneSlots::slot_range(blocks));
-                lane_pass::project_run(blocks, l, nodes, self.inv_mass, simd)
+                lane_pass::project_run(blocks, l, nodes, simd)
             };
             return;
         }
@@ -119,8 +112,8 @@ impl<'a> RunProjector<'a> {
         for (slot, lambda) in slots.iter().zip(lambdas).filter(|(s, _)| s.live) {
             let idx = slot.nodes;
             // SAFETY: the caller's contract.
-            let mut p = idx.map(|i| unsafe { nodes.get(i) });
-            let w = idx.map(|i| self.inv_mass[i as usize]);
+            let read = idx.map(|i| unsafe { nodes.get(i) });
+            let (mut p, w) = (read.map(|r| r.0), read.map(|r| r.1));
             *lambda = project_tet(&mut p, &w, &slot.terms, self.mode, self.pair);
             for k in 0..4 {
                 // SAFETY: as above.

@@ -1,13 +1,16 @@
-//! Unsynchronised shared access to node positions for the coloured parallel projection.
+//! Unsynchronised shared access to the sweep's node records for the coloured parallel
+//! projection.
 
 use glam::Vec3;
 
-/// A view of the position array that several threads read and write at once.
+use super::node_records::NodeRecord;
+
+/// A view of the node records ([`NodeRecord`]) that several threads read and write at once.
 ///
 /// Sound only under graph colouring: within one colour no two tets share a node, so every
 /// node is touched by at most one thread per colour pass (PHYSICS.md §1.2, parallel form).
 pub(crate) struct SharedNodes {
-    ptr: *mut Vec3,
+    ptr: *mut NodeRecord,
     len: usize,
 }
 
@@ -16,10 +19,10 @@ unsafe impl Sync for SharedNodes {}
 unsafe impl Send for SharedNodes {}
 
 impl SharedNodes {
-    pub(super) fn new(x: &mut [Vec3]) -> Self {
+    pub(super) fn new(records: &mut [NodeRecord]) -> Self {
         SharedNodes {
-            ptr: x.as_mut_ptr(),
-            len: x.len(),
+            ptr: records.as_mut_ptr(),
+            len: records.len(),
         }
     }
 
@@ -28,23 +31,24 @@ impl SharedNodes {
         self.len
     }
 
-    /// The first node's address (reads and writes through it follow the colouring too).
-    pub(super) fn as_ptr(&self) -> *mut Vec3 {
+    /// The first record's address (reads and writes through it follow the colouring too).
+    pub(super) fn as_ptr(&self) -> *mut NodeRecord {
         self.ptr
     }
 
-    /// Read node `i`.
+    /// Read node `i`'s displacement and inverse mass.
     ///
     /// # Safety
     /// No other thread may write node `i` during this colour pass.
     #[inline]
-    pub(super) unsafe fn get(&self, i: u32) -> Vec3 {
+    pub(super) unsafe fn get(&self, i: u32) -> (Vec3, f32) {
         assert!((i as usize) < self.len);
         // SAFETY: in bounds (checked); exclusive per colour by the caller's contract.
-        unsafe { *self.ptr.add(i as usize) }
+        let r = unsafe { *self.ptr.add(i as usize) };
+        (r.u, r.w)
     }
 
-    /// Write node `i`.
+    /// Write node `i`'s displacement.
     ///
     /// # Safety
     /// No other thread may read or write node `i` during this colour pass.
@@ -52,6 +56,6 @@ impl SharedNodes {
     pub(super) unsafe fn set(&self, i: u32, v: Vec3) {
         assert!((i as usize) < self.len);
         // SAFETY: as for `get`.
-        unsafe { *self.ptr.add(i as usize) = v }
+        unsafe { (*self.ptr.add(i as usize)).u = v }
     }
 }

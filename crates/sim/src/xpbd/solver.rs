@@ -10,6 +10,7 @@ use super::coloring::greedy_tet_colors;
 use super::lane_slots::LaneSlots;
 use super::locality::TetOrder;
 use super::neo_hookean::{ConstraintPair, TetTerms, deformation_gradient_from_displacement};
+use super::node_records::{self, NodeRecord};
 use super::release_schedule::release_checks;
 use super::run_projector::{RunProjector, SharedLambdas};
 use super::shared_nodes::SharedNodes;
@@ -59,6 +60,9 @@ pub struct Solver {
     /// body sits, and `F = I + Du Dm⁻¹` never subtracts large coordinates.
     pub(crate) u: Vec<Vec3>,
     pub(crate) u_prev: Vec<Vec3>,
+    /// The sweep's copy of `u` and `inv_mass`, a 16-byte record a node (kept between
+    /// sweeps only so as not to allocate one each).
+    pub(crate) records: Vec<NodeRecord>,
     pub(crate) v: Vec<Vec3>,
     pub(crate) mass: Vec<f32>,
     pub(crate) inv_mass: Vec<f32>,
@@ -201,6 +205,7 @@ impl Solver {
             x: mesh.rest_positions.clone(),
             u: vec![Vec3::ZERO; n],
             u_prev: vec![Vec3::ZERO; n],
+            records: Vec::new(),
             start: vec![Vec3::ZERO; n],
             v: vec![Vec3::ZERO; n],
             mass,
@@ -587,14 +592,7 @@ impl Solver {
         for s in 0..n {
             let t = self.time + (s + 1) as f64 * h as f64;
             self.predict(h, t);
-            match self.params.cpu_sweep {
-                CpuSweep::Coloured => {
-                    for c in 0..self.color_ranges.len() {
-                        self.project_color(c);
-                    }
-                }
-                CpuSweep::Blocks => self.project_blocks(),
-            }
+            self.sweep();
             self.project_contacts(s, n);
             self.update_velocities(h);
             fresh = next.next_if(|&&k| k == s).is_some();
@@ -707,13 +705,31 @@ impl Solver {
         for_each_zip3(self.team.as_ref(), arrays, TEAM_PART_NODES, node);
     }
 
+    /// One sweep over the live tets in the parameters' order, on the node records
+    /// (`xpbd/node_records.rs`): filled from `u` and the inverse masses before it, `u`
+    /// read back after it.
+    fn sweep(&mut self) {
+        let mut records = std::mem::take(&mut self.records);
+        node_records::fill(self.team.as_ref(), &mut records, &self.u, &self.inv_mass);
+        let nodes = SharedNodes::new(&mut records);
+        match self.params.cpu_sweep {
+            CpuSweep::Coloured => {
+                for c in 0..self.color_ranges.len() {
+                    self.project_color(c, &nodes);
+                }
+            }
+            CpuSweep::Blocks => self.project_blocks(&nodes),
+        }
+        node_records::read_back(self.team.as_ref(), &records, &mut self.u);
+        self.records = records;
+    }
+
     /// Project every live tet of colour `c` (no two share a node), in parts shared by the
     /// team where there is one.
-    fn project_color(&mut self, c: usize) {
+    fn project_color(&mut self, c: usize, nodes: &SharedNodes) {
         let range = self.color_ranges[c].clone();
         let packed = self.packed.as_ref();
-        let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
-        let nodes = SharedNodes::new(&mut self.u);
+        let projector = RunProjector::of(&self.params, &self.slots, packed);
         let lambdas = SharedLambdas::new(&mut self.lambda_h);
         // A colour of few tets costs less on one thread than split.
         let parts = match self.team {
@@ -723,7 +739,7 @@ impl Solver {
         // SAFETY: tets of one colour share no node, and the parts are disjoint; this pass
         // is the only one. The packed spans of the coloured sweep are its colours.
         let part =
-            |p: usize| unsafe { projector.span(c, range.clone(), &lambdas, &nodes, (p, parts)) };
+            |p: usize| unsafe { projector.span(c, range.clone(), &lambdas, nodes, (p, parts)) };
         match self.team.as_ref() {
             Some(team) => team.run(parts, part),
             None => part(0),
@@ -732,10 +748,9 @@ impl Solver {
 
     /// One sweep in the partitioned order (`xpbd/sweep_plan.rs`): phase after phase, the
     /// phase's groups shared by the team, each group's tets colour after colour.
-    fn project_blocks(&mut self) {
+    fn project_blocks(&mut self, nodes: &SharedNodes) {
         let packed = self.packed.as_ref();
-        let projector = RunProjector::of(&self.params, &self.inv_mass, &self.slots, packed);
-        let nodes = SharedNodes::new(&mut self.u);
+        let projector = RunProjector::of(&self.params, &self.slots, packed);
         let lambdas = SharedLambdas::new(&mut self.lambda_h);
         let (plan, colours) = (&self.plan, self.color_ranges.len());
         let group = |g: &usize| {
@@ -744,7 +759,7 @@ impl Solver {
                 // cuts), each run's tets are of one colour, and runs are disjoint ranges
                 // of the slots. The packed spans of the partitioned sweep are its runs,
                 // group by group.
-                unsafe { projector.span(*g * colours + c, r.clone(), &lambdas, &nodes, (0, 1)) };
+                unsafe { projector.span(*g * colours + c, r.clone(), &lambdas, nodes, (0, 1)) };
             }
         };
         for phase in &plan.phases {
