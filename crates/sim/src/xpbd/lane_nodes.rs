@@ -47,28 +47,24 @@ pub(crate) trait NodeLanes: Lane {
     /// No other thread may write these nodes during the call (colouring).
     #[inline(always)]
     unsafe fn load_nodes(b: &LaneBlock, nodes: &SharedNodes) -> ([V3<Self>; 4], [Self; 4]) {
-        let mut u = [[Vec3::ZERO; LANES]; 4];
-        let mut w = [[0.0f32; LANES]; 4];
+        // Node j's x, y, z and w, lane by lane.
+        let mut v = [[[0.0f32; LANES]; 4]; 4];
         for k in (0..LANES).filter(|&k| b.is_live(k)) {
-            for j in 0..4 {
+            for (j, v) in v.iter_mut().enumerate() {
                 // SAFETY: the caller's contract.
-                (u[j][k], w[j][k]) = unsafe { nodes.get(b.nodes[j][k]) };
+                let (u, w) = unsafe { nodes.get(b.nodes[j][k]) };
+                [v[0][k], v[1][k], v[2][k], v[3][k]] = [u.x, u.y, u.z, w];
             }
         }
         // Written out, not `map`: an out-of-line `map` would be compiled without the
         // caller's AVX and call each intrinsic.
         (
+            [row(&v[0]), row(&v[1]), row(&v[2]), row(&v[3])],
             [
-                V3::gather(&u[0]),
-                V3::gather(&u[1]),
-                V3::gather(&u[2]),
-                V3::gather(&u[3]),
-            ],
-            [
-                Self::new(w[0]),
-                Self::new(w[1]),
-                Self::new(w[2]),
-                Self::new(w[3]),
+                Self::new(v[0][3]),
+                Self::new(v[1][3]),
+                Self::new(v[2][3]),
+                Self::new(v[3][3]),
             ],
         )
     }
@@ -94,6 +90,16 @@ pub(crate) trait NodeLanes: Lane {
                 unsafe { nodes.set(b.nodes[j][k], Vec3::new(u[0][k], u[1][k], u[2][k])) };
             }
         }
+    }
+}
+
+/// The displacements of a node row read lane by lane (x, y, z, w arrays).
+#[inline(always)]
+fn row<L: Lane>(v: &[[f32; LANES]; 4]) -> V3<L> {
+    V3 {
+        x: L::new(v[0]),
+        y: L::new(v[1]),
+        z: L::new(v[2]),
     }
 }
 
@@ -301,8 +307,7 @@ mod avx {
                     let u = &u[j];
                     // Each live lane's record whole: its displacement and the inverse
                     // mass it was read with (a live lane's, unmasked).
-                    let [r0, r1, r2, r3] = transpose(u.x.raw(), u.y.raw(), u.z.raw(), w[j].raw());
-                    let halves = [r0, r1, r2, r3];
+                    let halves = transpose(u.x.raw(), u.y.raw(), u.z.raw(), w[j].raw());
                     let at = |k: usize| base.add(4 * b.nodes[j][k] as usize);
                     if live == 0xFF {
                         // Every lane live (the common block): no test per lane.
