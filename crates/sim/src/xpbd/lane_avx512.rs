@@ -14,7 +14,8 @@ use std::ops::{Add, BitAnd, Div, Mul, Neg, Sub};
 
 use super::lane::LaneMath;
 use super::lane_avx::{Avx, ln_of_parts};
-use super::lanes::{M3, V3};
+use super::lane_slots::LaneBlock;
+use super::lanes::{LANES, Lane, M3, V3};
 use super::rest_free_lanes::TetLanes;
 
 /// Number of lanes.
@@ -34,6 +35,18 @@ macro_rules! avx512 {
 }
 
 impl Avx512 {
+    /// The register.
+    #[inline(always)]
+    pub(super) fn raw(self) -> __m512 {
+        self.0
+    }
+
+    /// Lanes of a register (only where AVX-512F is present: module docs).
+    #[inline(always)]
+    pub(super) fn from_raw(v: __m512) -> Avx512 {
+        Avx512(v)
+    }
+
     /// Lanes 0–7 from `lo`, 8–15 from `hi`.
     #[inline(always)]
     pub(super) fn join(lo: Avx, hi: Avx) -> Avx512 {
@@ -225,24 +238,6 @@ fn join_v3(lo: V3<Avx>, hi: V3<Avx>) -> V3<Avx512> {
     }
 }
 
-/// Lanes 0–7 and 8–15.
-#[inline(always)]
-fn split_v3(v: V3<Avx512>) -> (V3<Avx>, V3<Avx>) {
-    let ((x0, x1), (y0, y1), (z0, z1)) = (v.x.split(), v.y.split(), v.z.split());
-    (
-        V3 {
-            x: x0,
-            y: y0,
-            z: z0,
-        },
-        V3 {
-            x: x1,
-            y: y1,
-            z: z1,
-        },
-    )
-}
-
 /// Lanes 0–7 from `lo`, 8–15 from `hi`.
 #[inline(always)]
 fn join_m3(lo: &M3<Avx>, hi: &M3<Avx>) -> M3<Avx512> {
@@ -253,37 +248,30 @@ fn join_m3(lo: &M3<Avx>, hi: &M3<Avx>) -> M3<Avx512> {
     }
 }
 
-/// Two blocks' tets in sixteen lanes: `lo`'s in 0–7, `hi`'s in 8–15.
+/// Two blocks' tets in sixteen lanes (`lo`'s in 0–7, `hi`'s in 8–15): their terms beside
+/// their nodes' displacements `u` and inverse masses `w` (read by
+/// [`super::lane_pair_nodes::load_pair`]).
 #[inline(always)]
-pub(super) fn join_tets(lo: &TetLanes<Avx>, hi: &TetLanes<Avx>) -> TetLanes<Avx512> {
+pub(super) fn pair_tets(
+    lo: &LaneBlock,
+    hi: &LaneBlock,
+    (u, w): ([V3<Avx512>; 4], [Avx512; 4]),
+) -> TetLanes<Avx512> {
     TetLanes {
-        u: [
-            join_v3(lo.u[0], hi.u[0]),
-            join_v3(lo.u[1], hi.u[1]),
-            join_v3(lo.u[2], hi.u[2]),
-            join_v3(lo.u[3], hi.u[3]),
-        ],
-        w: [
-            Avx512::join(lo.w[0], hi.w[0]),
-            Avx512::join(lo.w[1], hi.w[1]),
-            Avx512::join(lo.w[2], hi.w[2]),
-            Avx512::join(lo.w[3], hi.w[3]),
-        ],
-        dm_inv: join_m3(&lo.dm_inv, &hi.dm_inv),
-        alpha_h: Avx512::join(lo.alpha_h, hi.alpha_h),
-        alpha_d: Avx512::join(lo.alpha_d, hi.alpha_d),
-        live: Avx512::join(lo.live, hi.live),
+        u,
+        w,
+        dm_inv: join_m3(&M3::load(&lo.dm_inv), &M3::load(&hi.dm_inv)),
+        alpha_h: join_arrays(&lo.alpha_h, &hi.alpha_h),
+        alpha_d: join_arrays(&lo.alpha_d, &hi.alpha_d),
+        live: join_arrays(&lo.live, &hi.live),
     }
 }
 
-/// The displacements of lanes 0–7 and of lanes 8–15.
+/// Lanes 0–7 from `lo`, 8–15 from `hi` (no closure: it would be compiled without the
+/// caller's AVX-512 and call each intrinsic).
 #[inline(always)]
-pub(super) fn split_displacements(u: &[V3<Avx512>; 4]) -> ([V3<Avx>; 4], [V3<Avx>; 4]) {
-    let (a0, b0) = split_v3(u[0]);
-    let (a1, b1) = split_v3(u[1]);
-    let (a2, b2) = split_v3(u[2]);
-    let (a3, b3) = split_v3(u[3]);
-    ([a0, a1, a2, a3], [b0, b1, b2, b3])
+fn join_arrays(lo: &[f32; LANES], hi: &[f32; LANES]) -> Avx512 {
+    Avx512::join(Avx::new(*lo), Avx::new(*hi))
 }
 
 #[cfg(test)]

@@ -106,6 +106,9 @@ fn row<L: Lane>(v: &[[f32; LANES]; 4]) -> V3<L> {
 impl NodeLanes for wide::f32x8 {}
 
 #[cfg(target_arch = "x86_64")]
+pub(super) use avx::rows_below;
+
+#[cfg(target_arch = "x86_64")]
 mod avx {
     use std::arch::x86_64::*;
 
@@ -239,7 +242,7 @@ mod avx {
 
     /// Whether every index of the rows is below `len`.
     #[inline(always)]
-    fn rows_below(rows: &[[u32; LANES]], len: usize) -> bool {
+    pub(in crate::xpbd) fn rows_below(rows: &[[u32; LANES]], len: usize) -> bool {
         if len == 0 || len > i32::MAX as usize {
             return len != 0 && rows.iter().flatten().all(|&i| (i as usize) < len);
         }

@@ -6,7 +6,7 @@
 use super::lane_avx::Avx;
 use super::lane_nodes::NodeLanes;
 use super::lane_slots::{LaneBlock, LaneSlots};
-use super::lanes::{LANES, M3, V3};
+use super::lanes::{LANES, Lane, M3, V3};
 use super::rest_free_lanes::{TetLanes, project_rest_free_lanes};
 use super::shared_nodes::SharedNodes;
 
@@ -63,6 +63,13 @@ unsafe fn finish_block<L: NodeLanes>(
 ) {
     // SAFETY: the caller's contract.
     unsafe { L::store_nodes(b, u, w, nodes) };
+    store_multipliers(b, dl_h, lambdas, base);
+}
+
+/// Store the block's live lanes' multipliers `dl_h` in `lambdas` (which starts at slot
+/// `base`).
+#[inline(always)]
+fn store_multipliers<L: Lane>(b: &LaneBlock, dl_h: L, lambdas: &mut [f32], base: usize) {
     let dl_h = dl_h.to_array();
     let first = b.first as usize - base;
     // Every lane live (padding lanes never are, so a full block).
@@ -138,20 +145,20 @@ unsafe fn project_run_avx2(blocks: &[LaneBlock], lambdas: &mut [f32], nodes: &Sh
 #[allow(clippy::incompatible_msrv)]
 #[target_feature(enable = "avx,avx2,avx512f")]
 unsafe fn project_run_avx512(blocks: &[LaneBlock], lambdas: &mut [f32], nodes: &SharedNodes) {
-    use super::lane_avx512::{join_tets, split_displacements};
+    use super::lane_avx512::pair_tets;
+    use super::lane_pair_nodes::{load_pair, store_pair};
     let base = LaneSlots::slot_range(blocks).start;
     let mut pairs = blocks.chunks_exact(2);
     for pair in &mut pairs {
         let (lo, hi) = (&pair[0], &pair[1]);
-        // SAFETY: the caller's contract (the blocks are of one colour: no node in both).
+        // SAFETY: the caller's contract (the blocks are of one colour: no node in both);
+        // the CPU has AVX-512F.
         unsafe {
-            let a = block_lanes::<Avx>(lo, nodes);
-            let b = block_lanes::<Avx>(hi, nodes);
-            let mut lanes = join_tets(&a, &b);
+            let mut lanes = pair_tets(lo, hi, load_pair(lo, hi, nodes));
             let (dl_lo, dl_hi) = project_rest_free_lanes(&mut lanes).split();
-            let (u_lo, u_hi) = split_displacements(&lanes.u);
-            finish_block(lo, (&u_lo, &a.w), dl_lo, lambdas, base, nodes);
-            finish_block(hi, (&u_hi, &b.w), dl_hi, lambdas, base, nodes);
+            store_pair(lo, hi, &lanes.u, &lanes.w, nodes);
+            store_multipliers(lo, dl_lo, lambdas, base);
+            store_multipliers(hi, dl_hi, lambdas, base);
         }
     }
     for b in pairs.remainder() {

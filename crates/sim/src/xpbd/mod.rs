@@ -13,6 +13,9 @@ pub(crate) mod lane_avx;
 #[allow(clippy::incompatible_msrv)]
 mod lane_avx512;
 pub(crate) mod lane_nodes;
+#[cfg(all(target_arch = "x86_64", incise_avx512))]
+#[allow(clippy::incompatible_msrv)]
+mod lane_pair_nodes;
 mod lane_pass;
 mod lane_slots;
 pub(crate) mod lanes;
