@@ -196,7 +196,12 @@ mod avx {
                 records(base, idx, 3),
             )
         };
-        let [x, y, z, w] = [x, y, z, w].map(Avx::from_raw);
+        let (x, y, z, w) = (
+            Avx::from_raw(x),
+            Avx::from_raw(y),
+            Avx::from_raw(z),
+            Avx::from_raw(w),
+        );
         (
             V3 {
                 x: x & live,

@@ -80,7 +80,12 @@ unsafe fn read_row(
             quarters(base, a, b, 3),
         )
     };
-    let [x, y, z, w] = [x, y, z, w].map(Avx512::from_raw);
+    let (x, y, z, w) = (
+        Avx512::from_raw(x),
+        Avx512::from_raw(y),
+        Avx512::from_raw(z),
+        Avx512::from_raw(w),
+    );
     (
         V3 {
             x: x & live,
