@@ -21,7 +21,7 @@
 use glam::Vec3;
 
 use super::lane_slots::LaneBlock;
-use super::lanes::{LANES, Lane, V3};
+use super::lanes::{LANES, Lane, LaneMath, V3};
 use super::node_records::NodeRecord;
 use super::shared_nodes::SharedNodes;
 
@@ -91,6 +91,20 @@ pub(crate) trait NodeLanes: Lane {
             }
         }
     }
+}
+
+/// A node row's columns `x, y, z, w` as displacements and inverse masses, each zero where
+/// `live` is clear (what the AVX and AVX-512 reads make of their transposed records).
+#[inline(always)]
+pub(super) fn masked_row<L: LaneMath>([x, y, z, w]: [L; 4], live: L) -> (V3<L>, L) {
+    (
+        V3 {
+            x: x & live,
+            y: y & live,
+            z: z & live,
+        },
+        w & live,
+    )
 }
 
 /// The displacements of a node row read lane by lane (x, y, z, w arrays).
@@ -196,20 +210,13 @@ mod avx {
                 records(base, idx, 3),
             )
         };
-        let (x, y, z, w) = (
+        let raw = [
             Avx::from_raw(x),
             Avx::from_raw(y),
             Avx::from_raw(z),
             Avx::from_raw(w),
-        );
-        (
-            V3 {
-                x: x & live,
-                y: y & live,
-                z: z & live,
-            },
-            w & live,
-        )
+        ];
+        masked_row(raw, live)
     }
 
     /// The records of lanes `k` (low half) and `k + 4` (high half).

@@ -10,7 +10,7 @@ use std::arch::x86_64::*;
 
 use super::lane_avx::Avx;
 use super::lane_avx512::Avx512;
-use super::lane_nodes::rows_below;
+use super::lane_nodes::{masked_row, rows_below};
 use super::lane_slots::LaneBlock;
 use super::lanes::{LANES, Lane, V3};
 use super::node_records::NodeRecord;
@@ -80,20 +80,13 @@ unsafe fn read_row(
             quarters(base, a, b, 3),
         )
     };
-    let (x, y, z, w) = (
+    let raw = [
         Avx512::from_raw(x),
         Avx512::from_raw(y),
         Avx512::from_raw(z),
         Avx512::from_raw(w),
-    );
-    (
-        V3 {
-            x: x & live,
-            y: y & live,
-            z: z & live,
-        },
-        w & live,
-    )
+    ];
+    masked_row(raw, live)
 }
 
 /// The blocks' nodes in sixteen lanes (`lo`'s in 0–7, `hi`'s in 8–15): displacements and
