@@ -33,4 +33,5 @@ pub use params::{CoarseRefresh, NewtonParams, Scheme, Smoother};
 pub use pcg::{CgReport, dot, pcg};
 pub use rest_tet::RestTet;
 pub use tet_tangent::TetTangent;
+pub(crate) use workspace::FirstTrial;
 pub use workspace::NewtonWorkspace;

@@ -12,7 +12,7 @@ use super::GpuNewton;
 use super::layout::{ALPHA_OFFSET, S_FIRST, S_NEG, S_PRODUCTS, S_STOP, V_TRIAL};
 use crate::gpu::GpuError;
 use crate::gpu::readback::read_mapped;
-use crate::implicit::NewtonReport;
+use crate::implicit::{FirstTrial, NewtonReport};
 use crate::thread_team::ThreadTeam;
 
 /// Armijo constant of the line search (the CPU's).
@@ -144,7 +144,8 @@ impl GpuNewton {
             report.iterations += 1;
             report.cg_products += products;
             report.negative_curvature += u32::from(negative);
-            let (next, taken) = self.line_search(dev, next, now.g, &mut report)?;
+            let first = FirstTrial::after(negative);
+            let (next, taken) = self.line_search(dev, next, now.g, first, &mut report)?;
             enc = next;
             match taken {
                 Some((sums, moved)) => {
@@ -212,15 +213,17 @@ impl GpuNewton {
     }
 
     /// Backtrack along the direction from the iterate until `G` decreases enough (as
-    /// `NewtonWorkspace::line_search`): the full step is evaluated in full, a halved one
-    /// for its energy only and in full once taken. Returns the sums at the point taken and
-    /// how far the step moved the furthest free node, or `None` (the iterate stays) when
-    /// the direction does not descend or no halving decreased `G`.
+    /// `NewtonWorkspace::line_search`): the full step is evaluated as `first` says, a
+    /// halved one for its energy only, and a point evaluated for its energy alone in full
+    /// once taken. Returns the sums at the point taken and how far the step moved the
+    /// furthest free node, or `None` (the iterate stays) when the direction does not
+    /// descend or no halving decreased `G`.
     fn line_search(
         &mut self,
         dev: &OnDevice<'_>,
         mut enc: wgpu::CommandEncoder,
         g_now: f64,
+        first: FirstTrial,
         report: &mut NewtonReport,
     ) -> Result<(wgpu::CommandEncoder, Option<(Sums, f32)>), GpuError> {
         let mut alpha = 1.0f32;
@@ -232,7 +235,8 @@ impl GpuNewton {
                 .write_buffer(&self.buf.uniform, ALPHA_OFFSET, bytemuck::bytes_of(&alpha));
             let (k, b) = (&self.kernels, &self.bind);
             let (ng, tg, _) = self.groups;
-            let list = if halving == 0 {
+            let full = halving == 0 && first == FirstTrial::Full;
+            let list = if full {
                 [
                     (&k.trial, &b.nodes, ng),
                     (&k.evaluate, &b.tets, tg),
@@ -256,7 +260,7 @@ impl GpuNewton {
                 }
             }
             if at.g <= g_now + ARMIJO * alpha as f64 * slope + rounding {
-                if halving > 0 {
+                if !full {
                     let (k, b) = (&self.kernels, &self.bind);
                     self.dispatches += record(
                         &mut enc,
