@@ -703,14 +703,22 @@ fn realtime_script() -> String {
 
 /// `incise xr` on [`realtime_script`] with `args`.
 fn run_realtime(name: &str, args: &[&str]) -> (std::process::Output, std::path::PathBuf) {
-    let script = realtime_script();
+    run_realtime_on(name, &realtime_script(), args)
+}
+
+/// `incise xr` on `script` (a [`realtime_script`] changed) with `args`.
+fn run_realtime_on(
+    name: &str,
+    script: &str,
+    args: &[&str],
+) -> (std::process::Output, std::path::PathBuf) {
     // plate_cut on XPBD: these runs time the session's threads against a slowed solver,
     // and were set on XPBD's frame (on the implicit scheme, which the shipped scene runs,
     // the in-frame run's last frames outlast the script's end: 144 refreshes shown).
     let scene = common::scene_on_scheme("plate_cut.ron", "Xpbd", &format!("{name}-scene"));
     let mut all = vec![scene.to_str().unwrap()];
     all.extend_from_slice(args);
-    run_xr(name, &script, &all)
+    run_xr(name, script, &all)
 }
 
 /// The report's figures of issue 19 item 3.
@@ -808,7 +816,11 @@ fn a_slow_solver_on_its_thread_costs_the_realtime_headset_no_frame() {
 /// On the simulation thread, a solver failure (a NaN before simulation frame 4) resets
 /// the scene and the session goes on; a panic (before frame 12) ends the session with a
 /// clear error, exit 1, and the report, frame log and stroke kept. (Early frames: on two
-/// shared cores the thread may step only a few a second.)
+/// shared cores the thread may step only a few a second.) In the panicking run the
+/// controller is tracked from the display's first frame, so each of the 12 frames records
+/// a pose whatever the display's pace: with the script's 0.1 s of untracked controller, a
+/// display slowed by a busy machine could leave the thread stepping all 12 on untracked
+/// commands, and no stroke to keep.
 #[test]
 fn a_failing_or_panicking_simulation_thread_keeps_the_outputs() {
     let (o, out) = run_realtime("xr-rt-nan", &["--sim", "thread", "--inject-nan-at", "4"]);
@@ -817,8 +829,15 @@ fn a_failing_or_panicking_simulation_thread_keeps_the_outputs() {
     assert_eq!(r["solver_resets"].as_u64(), Some(1), "{r}");
     assert_eq!(r["exit"], "Exited", "{r}");
 
-    let (o, out) = run_realtime(
+    let tracked_at_once = realtime_script().replace("start: 0.1,", "start: 0.0,");
+    assert_ne!(
+        tracked_at_once,
+        realtime_script(),
+        "the tool's start is in the script"
+    );
+    let (o, out) = run_realtime_on(
         "xr-rt-panic",
+        &tracked_at_once,
         &["--sim", "thread", "--inject-sim-panic-at", "12"],
     );
     let err = text(&o.stderr);
@@ -842,8 +861,9 @@ fn a_failing_or_panicking_simulation_thread_keeps_the_outputs() {
         csv.lines().count() as u64,
         r["frames"].as_u64().unwrap() + 1
     );
+    // A pose from each frame stepped before the panic.
     let stroke = incise_scalpel::load_stroke(&out.join("stroke.ron")).unwrap();
-    assert!(stroke.keys().len() >= 2, "the stroke up to the panic");
+    assert_eq!(stroke.keys().len(), 12, "the stroke up to the panic");
 }
 
 /// A Nakao exercise in the headset: the body stepped in the frame, the blade the
