@@ -70,6 +70,10 @@ pub struct Solver {
     pub(crate) start: Vec<Vec3>,
     pub(crate) grabs: Vec<Grab>,
     pub(crate) slots: Vec<TetSlot>,
+    /// Per mesh tet, whether its slot is live (the slots' flags in mesh order, kept by
+    /// `set_live`): what the passes that go tet by tet read, one byte after another
+    /// rather than one slot's cache line a tet.
+    tet_live: Vec<bool>,
     /// The slots packed for the SIMD lanes, span by span of the sweep (lane kernels only).
     pub(crate) packed: Option<LaneSlots>,
     /// The order of the tets inside each colour and group.
@@ -213,6 +217,7 @@ impl Solver {
             kind: vec![NodeKind::Free; n],
             grabs: Vec::new(),
             slots: Vec::new(),
+            tet_live: vec![true; t],
             packed: None,
             tet_order,
             color_ranges,
@@ -275,15 +280,14 @@ impl Solver {
     /// Per mesh tet, whether it is live in the sweep now (its slot: release checks inside
     /// a frame switch tets off here before the cut state hears of them).
     pub(crate) fn live_tets(&self) -> Vec<bool> {
-        (self.slot_of_tet.iter())
-            .map(|&slot| self.slots[slot as usize].live)
-            .collect()
+        self.tet_live.clone()
     }
 
     /// Switch mesh tet `t` on or off in the sweep (its slot and packed lane).
     fn set_live(&mut self, t: u32, live: bool) {
         let s = self.slot_of_tet[t as usize] as usize;
         self.slots[s].live = live;
+        self.tet_live[t as usize] = live;
         if let Some(p) = &mut self.packed {
             p.set_live(s, live);
         }
@@ -827,7 +831,7 @@ impl Solver {
         let eval = TetStressEval {
             mesh: &self.mesh,
             u: &self.u,
-            slots: &self.slots,
+            live: &self.tet_live,
             slot_of_tet: &self.slot_of_tet,
             lambda_h: &self.lambda_h,
             lame: self.lame,
@@ -879,7 +883,7 @@ impl Solver {
         };
         let near_edge = matches!(self.params.cut_zone, CutZone::NearEdge { .. });
         let over: Vec<u32> = (0..self.von_mises.len())
-            .filter(|&t| self.slots[self.slot_of_tet[t] as usize].live)
+            .filter(|&t| self.tet_live[t])
             .filter(|&t| self.von_mises[t] > threshold)
             .filter(|&t| {
                 !near_edge
@@ -969,7 +973,8 @@ impl Solver {
 struct TetStressEval<'a> {
     mesh: &'a TetMesh,
     u: &'a [Vec3],
-    slots: &'a [TetSlot],
+    /// Per mesh tet, whether it is live.
+    live: &'a [bool],
     slot_of_tet: &'a [u32],
     lambda_h: &'a [f32],
     lame: Lame,
@@ -982,8 +987,7 @@ struct TetStressEval<'a> {
 impl TetStressEval<'_> {
     /// σ_vM, det F and rotation of tet `t` (zero stress when switched off).
     fn tet(&self, t: usize, out: (&mut f32, &mut f32, &mut Quat)) {
-        let slot = self.slot_of_tet[t] as usize;
-        if !self.slots[slot].live {
+        if !self.live[t] {
             *out.0 = 0.0;
             return;
         }
@@ -998,7 +1002,7 @@ impl TetStressEval<'_> {
             }
             StressMeasure::PaperEq3 => {
                 let f: Mat3 = deformation_gradient_from_displacement(&d, dm_inv);
-                let lam = self.lambda_h[slot];
+                let lam = self.lambda_h[self.slot_of_tet[t] as usize];
                 let st = tet_stress(
                     &f,
                     self.lame.mu,
@@ -1012,5 +1016,82 @@ impl TetStressEval<'_> {
                 *out.2 = st.rotation;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::block;
+
+    /// A 768-tet block on a team of two, its nodes shaken so that the stress varies
+    /// from tet to tet, with a release threshold.
+    fn shaken() -> Solver {
+        let raw = block(
+            Vec3::ZERO,
+            Vec3::new(0.04, 0.02, 0.02),
+            glam::UVec3::new(8, 4, 4),
+        );
+        let mesh = TetMesh::from_raw(raw).unwrap().0;
+        let material = Material {
+            youngs_modulus: 10e3,
+            poisson_ratio: 0.4,
+            density: 1000.0,
+        };
+        let params = SolverParams {
+            threads: 2,
+            substeps: 40,
+            release_threshold: Some(1.2e3),
+            ..SolverParams::default()
+        };
+        let mut s = Solver::new(mesh, material, params).unwrap();
+        let mut x = s.positions().to_vec();
+        for (i, p) in x.iter_mut().enumerate() {
+            p.z += 4e-4 * ((i as f32) * 0.9).sin();
+        }
+        s.set_positions(&x);
+        s
+    }
+
+    /// Each mesh tet's flag in `tet_live` is its slot's.
+    fn flags_agree(s: &Solver) -> bool {
+        (0..s.mesh.tet_count()).all(|t| s.tet_live[t] == s.slots[s.slot_of_tet[t] as usize].live)
+    }
+
+    /// The stress pass and the release check read the slots' live flags in mesh order:
+    /// a release check switches tets off in both, the stress pass then skips them (zero
+    /// stress) and takes the others, and reviving the pending releases switches them on
+    /// in both again.
+    #[test]
+    fn the_tet_by_tet_passes_see_the_sweeps_live_flags() {
+        let mut s = shaken();
+        s.compute_stress();
+        s.switch_off_overstressed();
+        let off: Vec<usize> = (0..s.mesh.tet_count())
+            .filter(|&t| !s.tet_live[t])
+            .collect();
+        assert!(
+            !off.is_empty() && off.len() < s.mesh.tet_count() / 2,
+            "{} of {} tets released",
+            off.len(),
+            s.mesh.tet_count()
+        );
+        assert!(flags_agree(&s), "after the release check");
+        s.compute_stress();
+        assert!(
+            off.iter().all(|&t| s.von_mises[t] == 0.0),
+            "a released tet's stress"
+        );
+        let taken = (0..s.mesh.tet_count()).filter(|&t| s.tet_live[t] && s.von_mises[t] > 0.0);
+        assert!(
+            taken.count() > s.mesh.tet_count() / 2,
+            "the live tets' stress"
+        );
+        s.revive_pending();
+        assert!(
+            flags_agree(&s) && s.tet_live.iter().all(|&l| l),
+            "after reviving"
+        );
+        assert_eq!(s.live_tets(), s.tet_live);
     }
 }
