@@ -277,36 +277,21 @@ impl Solver {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::generate::block;
-    use crate::material::Material;
-    use crate::mesh::TetMesh;
     use crate::xpbd::SolverParams;
+    use crate::xpbd::solver::tests::soft_block;
 
     /// A 6,144-tet block on `threads`, every third node pushed through its neighbours.
     fn crushed(threads: usize) -> Solver {
-        let raw = block(
-            Vec3::ZERO,
-            Vec3::new(0.08, 0.04, 0.02),
-            glam::UVec3::new(16, 8, 8),
-        );
-        let mesh = TetMesh::from_raw(raw).unwrap().0;
-        let material = Material {
-            youngs_modulus: 10e3,
-            poisson_ratio: 0.4,
-            density: 1000.0,
-        };
         let params = SolverParams {
             threads,
-            substeps: 40,
             ..SolverParams::default()
         };
-        let mut s = Solver::new(mesh, material, params).unwrap();
-        let mut x = s.positions().to_vec();
-        for (i, p) in x.iter_mut().enumerate().step_by(3) {
-            p.z -= if i % 2 == 0 { 0.004 } else { -0.004 };
-        }
-        s.set_positions(&x);
-        s
+        let cells = (Vec3::new(0.08, 0.04, 0.02), glam::UVec3::new(16, 8, 8));
+        soft_block(cells, params, |i| match i % 6 {
+            0 => Vec3::Z * -0.004,
+            3 => Vec3::Z * 0.004,
+            _ => Vec3::ZERO,
+        })
     }
 
     /// The count of inverted live tets is the same counted in parts on a team as on one

@@ -1020,37 +1020,47 @@ impl TetStressEval<'_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::generate::block;
 
-    /// A 768-tet block on a team of two, its nodes shaken so that the stress varies
-    /// from tet to tet, with a release threshold.
-    fn shaken() -> Solver {
-        let raw = block(
-            Vec3::ZERO,
-            Vec3::new(0.04, 0.02, 0.02),
-            glam::UVec3::new(8, 4, 4),
-        );
-        let mesh = TetMesh::from_raw(raw).unwrap().0;
+    /// A block of `cells` cubes over `extent` m of soft tissue (E 10 kPa, ν 0.4) on
+    /// `params`, 40 substeps a frame, its nodes moved by `shift` (node index → m).
+    pub(crate) fn soft_block(
+        (extent, cells): (Vec3, glam::UVec3),
+        params: SolverParams,
+        shift: impl Fn(usize) -> Vec3,
+    ) -> Solver {
+        let mesh = TetMesh::from_raw(block(Vec3::ZERO, extent, cells))
+            .unwrap()
+            .0;
         let material = Material {
             youngs_modulus: 10e3,
             poisson_ratio: 0.4,
             density: 1000.0,
         };
         let params = SolverParams {
-            threads: 2,
             substeps: 40,
+            ..params
+        };
+        let mut s = Solver::new(mesh, material, params).unwrap();
+        let x: Vec<Vec3> = (s.positions().iter().enumerate())
+            .map(|(i, p)| *p + shift(i))
+            .collect();
+        s.set_positions(&x);
+        s
+    }
+
+    /// A 768-tet block on a team of two, its nodes shaken so that the stress varies
+    /// from tet to tet, with a release threshold.
+    fn shaken() -> Solver {
+        let params = SolverParams {
+            threads: 2,
             release_threshold: Some(1.2e3),
             ..SolverParams::default()
         };
-        let mut s = Solver::new(mesh, material, params).unwrap();
-        let mut x = s.positions().to_vec();
-        for (i, p) in x.iter_mut().enumerate() {
-            p.z += 4e-4 * ((i as f32) * 0.9).sin();
-        }
-        s.set_positions(&x);
-        s
+        let cells = (Vec3::new(0.04, 0.02, 0.02), glam::UVec3::new(8, 4, 4));
+        soft_block(cells, params, |i| Vec3::Z * 4e-4 * ((i as f32) * 0.9).sin())
     }
 
     /// Each mesh tet's flag in `tet_live` is its slot's.
