@@ -34,6 +34,7 @@ pub enum StressMeasure {
 /// stiffness) at the strain `s`, Pa. Below `J_MIN` the `1/J` factor is taken at `J_MIN`
 /// (an inverted tet has no Cauchy stress; the inversion guard handles it).
 // docs/physics-notes.md, true stress: σ = P Fᵀ / J.
+#[inline]
 pub fn cauchy_stress(s: &Strain, lame: Lame, pair: ConstraintPair, lambda_h: f32) -> Mat3 {
     let inv_j = 1.0 / s.j().max(J_MIN);
     let shape = s.b_minus_i() * (lame.mu * inv_j);
@@ -49,6 +50,7 @@ pub fn cauchy_stress(s: &Strain, lame: Lame, pair: ConstraintPair, lambda_h: f32
 
 /// von Mises stress `sqrt(3/2) ‖dev σ‖_F` of a symmetric stress.
 // PHYSICS.md §1.3, seed eq. (4).
+#[inline]
 pub fn von_mises(sigma: &Mat3) -> f32 {
     let mean = (sigma.x_axis.x + sigma.y_axis.y + sigma.z_axis.z) / 3.0;
     let dev = *sigma - Mat3::IDENTITY * mean;
