@@ -10,17 +10,18 @@ use glam::{Mat3, Vec3, Vec3A};
 use super::rest_tet::RestTet;
 use super::tet_tangent::TetTangent;
 use crate::xpbd::lane_nodes::NodeLanes;
-use crate::xpbd::lanes::{LANES, M3, V3, store_mat, store_vec};
+use crate::xpbd::lanes::{LANES, M3, V3, store_mat};
 
-/// Eight tets' rest data: nodes, `Dm⁻¹` and `V b_a` for a = 1, 2, 3 (lanes past `count`
-/// are padding). Matrices and vectors are stored entry by entry across the lanes, so
-/// each value is one contiguous load (issue 35 item 2).
+/// Eight tets' rest data: nodes, `Dm⁻¹` and the rest volumes (lanes past `count` are
+/// padding). Matrices are stored entry by entry across the lanes, so each value is one
+/// contiguous load (issue 35 item 2). The shape gradients `b_a` (a = 1, 2, 3) are the
+/// rows of `Dm⁻¹` and are read from it: a product streams these arrays for every tet,
+/// and storing `V b_a` as well made them 60 % larger.
 #[derive(Debug, Clone, Copy)]
 pub struct RestLanes {
     pub(super) nodes: [[u32; 4]; LANES],
     pub(super) count: usize,
     pub(super) dm_inv: [[f32; LANES]; 9],
-    pub(super) vb: [[[f32; LANES]; 3]; 3],
     /// Rest volumes (0 in padding lanes).
     pub(super) volume: [f32; LANES],
 }
@@ -44,29 +45,49 @@ impl TangentLanes {
     }
 }
 
-/// The rest data of `tets` (shape gradients `b`) in chunks of eight.
-pub fn rest_lanes(tets: &[RestTet], b: &[[Vec3; 4]]) -> Vec<RestLanes> {
+/// The rest data of `tets` in chunks of eight.
+pub fn rest_lanes(tets: &[RestTet]) -> Vec<RestLanes> {
     tets.chunks(LANES)
-        .zip(b.chunks(LANES))
-        .map(|(t, b)| {
+        .map(|t| {
             let mut r = RestLanes {
                 nodes: [[0; 4]; LANES],
                 count: t.len(),
                 dm_inv: [[0.0; LANES]; 9],
-                vb: [[[0.0; LANES]; 3]; 3],
                 volume: [0.0; LANES],
             };
             for k in 0..t.len() {
                 r.nodes[k] = t[k].nodes;
                 r.volume[k] = t[k].volume;
                 store_mat(&mut r.dm_inv, k, t[k].dm_inv);
-                for a in 0..3 {
-                    store_vec(&mut r.vb[a], k, b[k][a + 1] * t[k].volume);
-                }
             }
             r
         })
         .collect()
+}
+
+/// `V b_a` per lane for a = 1, 2, 3: row `a − 1` of `Dm⁻¹` (`vbd::shape_gradients`), times
+/// the rest volume, as the scalar product forms it.
+#[inline(always)]
+fn volume_gradients<L: NodeLanes>(rest: &RestLanes) -> [V3<L>; 3] {
+    let (d, v) = (&rest.dm_inv, L::new(rest.volume));
+    // Written out, not a closure (see forces_in).
+    [
+        V3 {
+            x: L::new(d[0]) * v,
+            y: L::new(d[3]) * v,
+            z: L::new(d[6]) * v,
+        },
+        V3 {
+            x: L::new(d[1]) * v,
+            y: L::new(d[4]) * v,
+            z: L::new(d[7]) * v,
+        },
+        V3 {
+            x: L::new(d[2]) * v,
+            y: L::new(d[5]) * v,
+            z: L::new(d[8]) * v,
+        },
+    ]
 }
 
 /// The tangents `t(0..n)` (n ≤ 8) in lanes; the lanes past `n` are unused.
@@ -185,9 +206,10 @@ fn forces_in<L: NodeLanes>(rest: &RestLanes, tan: &TangentLanes, p: &[Vec3]) -> 
         c2: df.c0.cross(f.c1) + f.c0.cross(df.c1),
     };
     let dp = df * mu + cof * (c * dj) + dcof * s3;
-    let f1 = dp.mul_vec(V3::load(&rest.vb[0]));
-    let f2 = dp.mul_vec(V3::load(&rest.vb[1]));
-    let f3 = dp.mul_vec(V3::load(&rest.vb[2]));
+    let [vb1, vb2, vb3] = volume_gradients::<L>(rest);
+    let f1 = dp.mul_vec(vb1);
+    let f2 = dp.mul_vec(vb2);
+    let f3 = dp.mul_vec(vb3);
     let f0 = -(f1 + f2 + f3);
     [f0, f1, f2, f3]
 }

@@ -45,7 +45,7 @@ pub(super) enum TetEvals {
 
 impl TetEvals {
     /// Every tet at rest (tangents of linear elasticity), in lanes or tet by tet.
-    pub(super) fn at_rest(tets: &[RestTet], b: &[[Vec3; 4]], lame: Lame, lanes: bool) -> Self {
+    pub(super) fn at_rest(tets: &[RestTet], lame: Lame, lanes: bool) -> Self {
         let tangent = TetTangent::at_rest(lame);
         if !lanes {
             let rest = TetEval {
@@ -56,7 +56,7 @@ impl TetEvals {
             };
             return TetEvals::Scalar(vec![rest; tets.len()]);
         }
-        let rest = rest_lanes(tets, b);
+        let rest = rest_lanes(tets);
         TetEvals::Lanes {
             evals: vec![EvalLanes::ZERO; rest.len()],
             tangents: vec![tangent_lanes(0, |_| tangent); rest.len()],

@@ -70,7 +70,7 @@ impl NewtonWorkspace {
         let n = mesh.node_count();
         let b: Vec<[Vec3; 4]> = tets.iter().map(|t| shape_gradients(&t.dm_inv)).collect();
         let level = CoarseLevel::new(mesh, (&tets, &b), (mass, free), (lame, h), &params, team)?;
-        let evals = TetEvals::at_rest(&tets, &b, lame, lanes);
+        let evals = TetEvals::at_rest(&tets, lame, lanes);
         let matrix = (params.smoother == Smoother::GaussSeidel).then(|| BlockMatrix::new(n, &tets));
         Ok(NewtonWorkspace {
             params,
