@@ -255,7 +255,8 @@ fn bench_markdown_prints_the_documents_rows() {
 /// `incise bench realtime` (issue 17, item 6): the scene at its own substeps, one JSON
 /// object with the split of a frame; with `--markdown` the CPU kernels and the implicit
 /// scheme (issue 31, item 3) interleaved, a
-/// row each, under the line with the command, machine, date and load average.
+/// row each, under the line with the command, machine, date and load average, the
+/// implicit scheme also over the whole scene, each row saying which frames it timed.
 #[test]
 fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
     // plate_cut on XPBD, the scheme whose sweep the JSON's figures describe (the shipped
@@ -282,8 +283,10 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
         "{r}"
     );
     assert_eq!(r["cpu_kernel"], "Lanes", "the default kernel: {r}");
-    // The frames stepped untimed, which scripts/lane-instructions.sh counts in.
+    // The frames stepped untimed, which scripts/lane-instructions.sh counts in, and the
+    // scene's own (3.2 s at 60 Hz).
     assert_eq!(r["warm_up_frames"].as_u64(), Some(2), "{r}");
+    assert_eq!(r["scene_frames"].as_u64(), Some(192), "{r}");
     let f = |k: &str| r[k].as_f64().unwrap();
     assert!(f("substeps_ms_median") > 0.0, "{r}");
     assert!(f("frame_ms_median") >= f("substeps_ms_median"), "{r}");
@@ -323,7 +326,8 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
             "Lanes",
             "Lanes, Blocks",
             "Avx2Lanes, Blocks",
-            "Newton"
+            "Newton",
+            "Newton, whole scene"
         ],
         "{out}"
     );
@@ -352,7 +356,16 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
             (sweeps - want).abs() <= 0.1 + 0.03 * want,
             "fine sweeps a frame {sweeps} against {frame} / {unit} ms: {row}"
         );
-        if cells[5] == "Newton" {
+        // The frames timed after the two warm-up ones: `--frames 1`, or all the scene's.
+        let whole = cells[5].ends_with(", whole scene");
+        assert_eq!(cells[16], if whole { "2–191" } else { "2–2" }, "{row}");
+        // Each run's 95th-percentile frame is at least its median frame.
+        let p95: f64 = cells[17].parse().unwrap();
+        assert!(
+            p95 >= frame - 0.05,
+            "p95 {p95} against the median {frame}: {row}"
+        );
+        if cells[5].starts_with("Newton") {
             // No sweeps to time or count flops of.
             assert_eq!(
                 (cells[8], cells[10], cells[11]),

@@ -46,8 +46,13 @@ pub struct RealtimeResult {
     pub frames: usize,
     /// Frames stepped before the timed ones and not timed ([`WARM_UP_FRAMES`]).
     pub warm_up_frames: u64,
+    /// Frames the scene runs for its duration (the timed ones are frames
+    /// `warm_up_frames` to `warm_up_frames + frames − 1` of them).
+    pub scene_frames: u64,
     /// Median wall ms per frame.
     pub frame_ms_median: f64,
+    /// 95th-percentile wall ms per frame.
+    pub frame_ms_p95: f64,
     /// 99th-percentile wall ms per frame.
     pub frame_ms_p99: f64,
     /// Median ms of the substeps (prediction, projection, contact, velocities).
@@ -85,7 +90,9 @@ pub const MARKDOWN_RUNS: usize = 3;
 /// Time `frames` frames of `scene` on `device` and print a table row, the JSON, or (with
 /// `Markdown`) the XPBD kernels and the implicit scheme (the scene's Newton settings, or
 /// the defaults) interleaved, [`MARKDOWN_RUNS`] runs each, as the markdown table of
-/// docs/performance.md under its provenance line.
+/// docs/performance.md under its provenance line; on the CPU the implicit scheme also over
+/// the whole scene (its cost moves from frame to frame: settling, pulling, tearing, torn),
+/// the figure a trainee's session has.
 pub fn run(
     scene: &Path,
     device: DeviceChoice,
@@ -96,32 +103,35 @@ pub fn run(
     use crate::bench::BenchOutput;
     if output == BenchOutput::Markdown {
         let xpbd = Some(Scheme::Xpbd);
+        let on_xpbd = |k: CpuKernel, s: Option<CpuSweep>| (k, s, xpbd, frames);
         let mut kernels = match cpu.1 {
-            Some(k) => vec![(k, cpu.2, xpbd)],
+            Some(k) => vec![on_xpbd(k, cpu.2)],
             None => vec![
-                (CpuKernel::Scalar, Some(CpuSweep::Coloured), xpbd),
-                (CpuKernel::PortableLanes, Some(CpuSweep::Coloured), xpbd),
-                (CpuKernel::Lanes, Some(CpuSweep::Coloured), xpbd),
-                (CpuKernel::Lanes, Some(CpuSweep::Blocks), xpbd),
-                (CpuKernel::Avx2Lanes, Some(CpuSweep::Blocks), xpbd),
+                on_xpbd(CpuKernel::Scalar, Some(CpuSweep::Coloured)),
+                on_xpbd(CpuKernel::PortableLanes, Some(CpuSweep::Coloured)),
+                on_xpbd(CpuKernel::Lanes, Some(CpuSweep::Coloured)),
+                on_xpbd(CpuKernel::Lanes, Some(CpuSweep::Blocks)),
+                on_xpbd(CpuKernel::Avx2Lanes, Some(CpuSweep::Blocks)),
             ],
         };
         let on_cpu = device != DeviceChoice::Gpu;
         if on_cpu {
-            kernels.push((CpuKernel::Lanes, None, Some(newton_of(scene)?)));
+            let newton = Some(newton_of(scene)?);
+            kernels.push((CpuKernel::Lanes, None, newton, frames));
+            kernels.push((CpuKernel::Lanes, None, newton, whole_scene_frames(scene)?));
         }
         let mut runs: Vec<KernelRuns> = vec![KernelRuns::default(); kernels.len()];
         for _ in 0..MARKDOWN_RUNS {
-            for (k, (kernel, sweep, scheme)) in kernels.iter().enumerate() {
-                let choice = |threads| (threads, Some(*kernel), *sweep);
+            for (k, &(kernel, sweep, scheme, frames)) in kernels.iter().enumerate() {
+                let choice = |threads| (threads, Some(kernel), sweep);
                 runs[k].all.push(measure_scheme(
                     scene,
                     device,
                     choice(cpu.0),
-                    *scheme,
+                    scheme,
                     frames,
                 )?);
-                if on_cpu && *scheme == xpbd {
+                if on_cpu && scheme == xpbd {
                     let one = measure_scheme(scene, device, choice(Some(1)), xpbd, frames)?;
                     runs[k].one.push(one);
                 }
@@ -139,10 +149,23 @@ pub fn run(
     Ok(())
 }
 
+/// The frames a run timed, as "first–last" of the scene's frames.
+fn timed_frames(r: &RealtimeResult) -> String {
+    let first = r.warm_up_frames;
+    format!("{first}–{}", first + r.frames as u64 - 1)
+}
+
+/// The scene's frames after the warm-up ones: a run of that many times the whole scene.
+fn whole_scene_frames(scene: &Path) -> Result<u32> {
+    let s = crate::scene::load_scene(scene)?;
+    let frames = s.frame_count(s.solver.frame_dt as f64);
+    Ok(frames.saturating_sub(WARM_UP_FRAMES).max(1) as u32)
+}
+
 /// One result as a line of text.
 fn summary(r: &RealtimeResult) -> String {
     format!(
-        "{} on {} ({} kernel): {} tets, {} substeps/frame: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
+        "{} on {} ({} kernel): {} tets, {} substeps/frame, frames {} of {}: {:.1} ms/frame median ({:.1} p99) = {:.1} fps; \
          substeps {:.1} ms, release checks {:.1} ms, stress+guards {:.1} ms; \
          {:.3} ms a sweep, {:.2} GFLOP/s, {} passes a frame{}",
         r.scene,
@@ -150,6 +173,8 @@ fn summary(r: &RealtimeResult) -> String {
         r.cpu_kernel,
         r.tets,
         r.substeps,
+        timed_frames(r),
+        r.scene_frames,
         r.frame_ms_median,
         r.frame_ms_p99,
         r.frames_per_second,
@@ -183,12 +208,14 @@ fn median_of(rs: &[RealtimeResult], f: impl Fn(&RealtimeResult) -> f64) -> f64 {
 /// the runs of each run's median frame; the sweep on one thread and on all, their ratio,
 /// GFLOP/s and the share of the machine's peak on all threads; the frame's cost in fine
 /// sweeps (its median ms over the ms of one coloured `Lanes` XPBD sweep of the same mesh on
-/// all threads, measured in the same run: issue 31's yardstick); then how the peak and the
-/// flops were counted.
+/// all threads, measured in the same run: issue 31's yardstick); which of the scene's
+/// frames were timed ("whole scene" in the kernel cell where that is all of them after the
+/// warm-up) and the median over the runs of each run's 95th-percentile frame; then how the
+/// peak and the flops were counted.
 pub fn markdown(runs: &[KernelRuns]) -> String {
     let mut s = format!(
-        "{}\n\n| scene | device | tets | substeps / frame | kernel | ms/frame min / median | fps (median) | ms per sweep, 1 thread / all | 1 → all threads | GFLOP/s | % of peak | passes / frame | release checks ms | stress + guards ms | fine sweeps / frame |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "{}\n\n| scene | device | tets | substeps / frame | kernel | ms/frame min / median | fps (median) | ms per sweep, 1 thread / all | 1 → all threads | GFLOP/s | % of peak | passes / frame | release checks ms | stress + guards ms | fine sweeps / frame | frames timed | ms/frame p95 |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         crate::provenance::generated_by()
     );
     // The peak of the threads the CPU rows ran on (none for the GPU).
@@ -226,18 +253,24 @@ pub fn markdown(runs: &[KernelRuns]) -> String {
         } else {
             ("–".into(), "–".into(), "–".into())
         };
+        let whole = r.warm_up_frames + r.frames as u64 >= r.scene_frames;
+        let kernel = match whole {
+            true => format!("{}, whole scene", r.cpu_kernel),
+            false => r.cpu_kernel.clone(),
+        };
         s += &format!(
-            "| {} | {} | {} | {} | {} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep} | {scaling} | {gflops} | {share} | {} | {:.1} | {:.2} | {:.1} |\n",
+            "| {} | {} | {} | {} | {kernel} | {min:.1} / {median:.1} | {:.1} | {one} / {sweep} | {scaling} | {gflops} | {share} | {} | {:.1} | {:.2} | {:.1} | {} | {:.1} |\n",
             r.scene,
             r.device,
             r.tets,
             r.substeps,
-            r.cpu_kernel,
             1e3 / median,
             median_of(rs, |r| r.passes_per_frame as f64),
             median_of(rs, |r| r.release_checks_ms_median),
             median_of(rs, |r| r.stress_ms_median),
             median / unit.unwrap_or(median_of(rs, |r| r.sweep_ms_median)),
+            timed_frames(r),
+            median_of(rs, |r| r.frame_ms_p95),
         );
     }
     s += &format!(
@@ -278,6 +311,7 @@ fn measure_scheme(
     frames: u32,
 ) -> Result<RealtimeResult> {
     let mut scene = crate::scene::load_scene(scene_path)?;
+    let scene_frames = scene.frame_count(scene.solver.frame_dt as f64);
     if let Some(s) = scheme {
         scene.solver.scheme = s;
     }
@@ -357,7 +391,9 @@ fn measure_scheme(
         frame_dt,
         frames: frame.len(),
         warm_up_frames: WARM_UP_FRAMES,
+        scene_frames,
         frame_ms_median,
+        frame_ms_p95: percentile(&frame, 0.95),
         frame_ms_p99: percentile(&frame, 0.99),
         substeps_ms_median: median(&solve),
         release_checks_ms_median: median(&checks),
