@@ -403,6 +403,12 @@ fn bench_realtime_reports_the_scene_at_its_substeps_with_both_kernels() {
             ],
             "{out}"
         );
+        // Its controllers are untracked: the caption says the scalpel stays out.
+        let caption = out.lines().find(|l| l.starts_with("Headset: ")).unwrap();
+        assert!(
+            caption.contains("the scene's scalpel never reaches the tissue"),
+            "{caption}"
+        );
         let low = |cell: &str| -> f64 { cell.split_once('–').unwrap().0.parse().unwrap() };
         for r in &rows {
             assert!(low(r[3]) > 0.0, "simulation frames a second: {out}");

@@ -128,10 +128,19 @@ pub fn markdown(scene: &Path, runs: usize) -> Result<String> {
         let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         format!("{lo:.digits$}–{hi:.digits$}")
     };
+    // The script leaves the controllers untracked: a scalpel scene's blade stays out.
+    let blade = match loaded.tool {
+        Some(_) => {
+            " The controllers are untracked, so the scene's scalpel never reaches the \
+             tissue: these are its frames without the incision (the table above times the \
+             whole scene with it)."
+        }
+        None => "",
+    };
     let mut s = format!(
         "\nHeadset: a simulated Quest 3 on the wall clock at {DISPLAY_HZ} Hz for the scene's \
          {seconds:.1} s, the simulation on its own thread, the eyes 64 × 64 \
-         (`incise xr SCENE --simulated-headset`), {runs} interleaved runs each (min–max). \
+         (`incise xr SCENE --simulated-headset`), {runs} interleaved runs each (min–max).{blade} \
          Drawn: by the software renderer, on the cores the solver runs on. Not drawn \
          (`draw_eyes: false`): each frame's picture taken and uploaded, its drawing left to \
          a GPU that is not there, as a headset's GPU takes it off the cores. Within: the \
