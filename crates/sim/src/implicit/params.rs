@@ -85,8 +85,9 @@ pub enum CoarseRefresh {
     /// own. It fits less and less as the body rotates and stretches.
     Rest,
     /// The live tets' current tangents, re-assembled and refactorised at the first
-    /// iterate of every n-th implicit step; a released tet subtracts its blocks at the
-    /// tangent they were assembled with.
+    /// iterate of every n-th Newton solve (a step is one solve, or two where the blade's
+    /// contact solves it again: docs/physics-notes.md "The coarse refresh"); a released
+    /// tet subtracts its blocks at the tangent they were assembled with.
     Steps(u32),
     /// The current tangents, re-assembled at the first iterate of a step after one that
     /// spent more than this many conjugate-gradient products per Newton iteration.
