@@ -55,10 +55,10 @@ pub fn rest_lanes(tets: &[RestTet]) -> Vec<RestLanes> {
                 dm_inv: [[0.0; LANES]; 9],
                 volume: [0.0; LANES],
             };
-            for k in 0..t.len() {
-                r.nodes[k] = t[k].nodes;
-                r.volume[k] = t[k].volume;
-                store_mat(&mut r.dm_inv, k, t[k].dm_inv);
+            for (k, tet) in t.iter().enumerate() {
+                r.nodes[k] = tet.nodes;
+                r.volume[k] = tet.volume;
+                store_mat(&mut r.dm_inv, k, tet.dm_inv);
             }
             r
         })
