@@ -14,6 +14,7 @@ pub mod pictures;
 pub mod preview;
 pub mod progress;
 pub mod provenance;
+mod quantile;
 pub mod report;
 pub mod run;
 pub mod scene;

@@ -59,6 +59,25 @@ fn run_writes_report_snapshots_and_collection() {
     }
     let released = frames.last().unwrap()["released_total"].as_u64().unwrap();
     assert!(released > 0, "the bar should tear");
+    // The closing line's timing is the report's frame times: the median (nearest rank)
+    // and the frames over their summed time.
+    let stdout = text(&o.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("completed "))
+        .unwrap();
+    let mut ms: Vec<f64> = frames
+        .iter()
+        .map(|f| f["wall_ms"].as_f64().unwrap())
+        .collect();
+    let sustained = 1e3 * ms.len() as f64 / ms.iter().sum::<f64>();
+    ms.sort_by(f64::total_cmp);
+    let median = ms[((ms.len() - 1) as f64 * 0.5).round() as usize];
+    assert!(
+        line.contains(&format!("; {median:.1} ms a frame at the median, "))
+            && line.ends_with(&format!(", {sustained:.1} frames a second sustained")),
+        "{line}"
+    );
     // Releasing is irreversible: the count never decreases.
     let counts: Vec<u64> = frames
         .iter()

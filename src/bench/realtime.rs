@@ -16,7 +16,7 @@ use incise_sim::implicit::Scheme;
 use incise_sim::xpbd::{CpuKernel, CpuSweep, NODE_FLOPS_PER_SUBSTEP, projection_flops};
 use serde::Serialize;
 
-use crate::bench::soak::percentile;
+use crate::quantile::percentile;
 use crate::sim_body::{Body, DeviceChoice};
 
 /// The realtime figures of one device.

@@ -11,7 +11,7 @@ use anyhow::{Result, anyhow, bail};
 use serde::Serialize;
 
 use crate::bench::BenchOutput;
-use crate::bench::soak::percentile;
+use crate::quantile::percentile;
 use crate::report::localisation::LocalisationInfo;
 use crate::scene::Method;
 use crate::scene::load_scene;

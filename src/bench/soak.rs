@@ -18,6 +18,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, anyhow, bail};
 use serde::Serialize;
 
+use crate::quantile::percentile;
 use crate::report::{EdgeFrameStats, FrameData};
 use crate::scene::Method;
 use crate::scene::{ModelChoice, Scene, load_scene};
@@ -128,14 +129,6 @@ fn trim_allocator() {
 /// Open file descriptors of this process (Linux `/proc/self/fd`; 0 elsewhere).
 pub fn open_fds() -> usize {
     std::fs::read_dir("/proc/self/fd").map_or(0, |d| d.count())
-}
-
-/// The `q` quantile (nearest rank) of `sorted` (ascending); 0 when empty.
-pub(crate) fn percentile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return 0.0;
-    }
-    sorted[((sorted.len() - 1) as f64 * q).round() as usize]
 }
 
 /// One cut: what it left, where it ran, its frame times, ms, and the free nodes of its

@@ -13,6 +13,7 @@ use anyhow::{Context, Result};
 use incise_sim::xpbd::FrameStats;
 use serde::Serialize;
 
+use crate::quantile::percentile;
 use crate::scene::Method;
 use crate::scene::Scene;
 
@@ -326,8 +327,35 @@ impl Report {
             .with_context(|| format!("writing {}", path.display()))
     }
 
-    /// One line saying what the run did, in the quantities its model has.
+    /// One line saying what the run did, in the quantities its model has, and what its
+    /// frames cost in wall time.
     pub fn summary(&self) -> String {
+        let line = self.outcome();
+        match self.timing() {
+            Some(t) => format!("{line}; {t}"),
+            None => line,
+        }
+    }
+
+    /// The frames' wall time: the median and p95 frame and the frames a second the run
+    /// sustained (its frames over their summed time); `None` without frames.
+    fn timing(&self) -> Option<String> {
+        let mut ms: Vec<f64> = self.frames.iter().map(|f| f.wall_ms).collect();
+        if ms.is_empty() {
+            return None;
+        }
+        let mean = ms.iter().sum::<f64>() / ms.len() as f64;
+        ms.sort_by(f64::total_cmp);
+        Some(format!(
+            "{:.1} ms a frame at the median, {:.1} at p95, {:.1} frames a second sustained",
+            percentile(&ms, 0.5),
+            percentile(&ms, 0.95),
+            1e3 / mean
+        ))
+    }
+
+    /// What the run did, in the quantities its model has.
+    fn outcome(&self) -> String {
         let n = self.frames.len();
         let head = format!("completed {n} frames of {}", self.scene);
         let last = self.frames.last().map(|f| &f.stats);
