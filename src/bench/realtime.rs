@@ -108,7 +108,7 @@ pub fn run(
     use crate::bench::BenchOutput;
     if output == BenchOutput::Markdown {
         let xpbd = Some(Scheme::Xpbd);
-        let on_xpbd = |k: CpuKernel, s: Option<CpuSweep>| (k, s, xpbd, frames);
+        let on_xpbd = |k: CpuKernel, s: Option<CpuSweep>| (k, s, xpbd, Some(frames));
         let mut kernels = match cpu.1 {
             Some(k) => vec![on_xpbd(k, cpu.2)],
             None => vec![
@@ -122,8 +122,8 @@ pub fn run(
         let on_cpu = device != DeviceChoice::Gpu;
         if on_cpu {
             let newton = Some(newton_of(scene)?);
-            kernels.push((CpuKernel::Lanes, None, newton, frames));
-            kernels.push((CpuKernel::Lanes, None, newton, whole_scene_frames(scene)?));
+            kernels.push((CpuKernel::Lanes, None, newton, Some(frames)));
+            kernels.push((CpuKernel::Lanes, None, newton, None));
         }
         let mut runs: Vec<KernelRuns> = vec![KernelRuns::default(); kernels.len()];
         for _ in 0..MARKDOWN_RUNS {
@@ -158,13 +158,6 @@ pub fn run(
 fn timed_frames(r: &RealtimeResult) -> String {
     let first = r.warm_up_frames;
     format!("{first}–{}", first + r.frames as u64 - 1)
-}
-
-/// The scene's frames after the warm-up ones: a run of that many times the whole scene.
-fn whole_scene_frames(scene: &Path) -> Result<u32> {
-    let s = crate::scene::load_scene(scene)?;
-    let frames = s.frame_count(s.solver.frame_dt as f64);
-    Ok(frames.saturating_sub(WARM_UP_FRAMES).max(1) as u32)
 }
 
 /// One result as a line of text.
@@ -306,19 +299,22 @@ pub fn measure(
     cpu: CpuChoice,
     frames: u32,
 ) -> Result<RealtimeResult> {
-    measure_scheme(scene_path, device, cpu, None, frames)
+    measure_scheme(scene_path, device, cpu, None, Some(frames))
 }
 
-/// [`measure`] with the scheme replaced when `scheme` is given.
+/// [`measure`] with the scheme replaced when `scheme` is given, over `frames` frames after
+/// the warm-up (`None`: all the scene's).
 fn measure_scheme(
     scene_path: &Path,
     device: DeviceChoice,
     (threads, kernel, sweep): CpuChoice,
     scheme: Option<Scheme>,
-    frames: u32,
+    frames: Option<u32>,
 ) -> Result<RealtimeResult> {
     let mut scene = crate::scene::load_scene(scene_path)?;
     let scene_frames = scene.frame_count(scene.solver.frame_dt as f64);
+    // `None`: the whole scene, every frame after the warm-up ones.
+    let frames = frames.map_or(scene_frames.saturating_sub(WARM_UP_FRAMES), u64::from);
     if let Some(s) = scheme {
         scene.solver.scheme = s;
     }
@@ -351,7 +347,7 @@ fn measure_scheme(
         .with_context(|| format!("{}: placing the body", scene_path.display()))?;
     let (mut frame, mut solve, mut checks, mut stress, mut passes) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for f in 0..frames.max(1) as u64 + WARM_UP_FRAMES {
+    for f in 0..frames.max(1) + WARM_UP_FRAMES {
         if let Some(s) = &stroke {
             body.move_tool(s.pose_at((f + 1) as f64 * frame_dt as f64));
         }
